@@ -1,0 +1,37 @@
+//! Command-line front end. Each subcommand lives in its own module with its
+//! `Args` and a `run` that returns `anyhow::Result<()>`; errors print as one
+//! line on stderr and exit with status 1 (2 for bad arguments, from clap).
+
+use clap::{Parser, Subcommand};
+
+mod impact;
+
+#[derive(Parser)]
+#[command(name = "topple", version, about = "LZB multiple impacts for dominoes, Rapier and Bevy")]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Resolve one multiple impact given as JSON (FILE, or - for stdin).
+    Impact(impact::Args),
+}
+
+/// Parses the command line, runs the subcommand, returns the exit status.
+pub fn run() -> i32 {
+    let cli = Cli::parse();
+    let result = match cli.command {
+        Command::Impact(args) => impact::run(args),
+    };
+    match result {
+        Ok(()) => 0,
+        Err(err) => {
+            // One line: the error and its causes joined by ": ".
+            let line = format!("{err:#}").replace('\n', " ");
+            eprintln!("error: {line}");
+            1
+        }
+    }
+}

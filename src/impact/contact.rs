@@ -1,0 +1,118 @@
+//! Contacts and the contact law they carry into the impact.
+
+use serde::{Deserialize, Serialize};
+
+/// The material of one contact point: the power law F = k (−δ)^α (paper Eq. 25),
+/// the energetic restitution e (Eq. 23) and Coulomb friction (Eq. 20).
+///
+/// ```
+/// use topple::impact::ContactMaterial;
+/// let m = ContactMaterial::hertz(1e9).with_restitution(0.5).with_friction(0.2, 0.3);
+/// assert_eq!(m.exponent, 1.5);
+/// assert_eq!(m.stick_friction, 0.3);
+/// ```
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct ContactMaterial {
+    /// Contact stiffness k (N/m^α); only ratios between contacts matter.
+    pub stiffness: f64,
+    /// Exponent α of the force law: 1.5 for Hertz, 1 for linear.
+    pub exponent: f64,
+    /// Energetic coefficient of restitution e ∈ [0, 1].
+    pub restitution: f64,
+    /// Sliding friction μ ≥ 0 used during the impact.
+    pub friction: f64,
+    /// Sticking friction μ_s ≥ 0: a sticking contact stays stuck while
+    /// |dP_t| ≤ μ_s dP_n.
+    pub stick_friction: f64,
+}
+
+impl ContactMaterial {
+    /// Hertzian (α = 1.5), perfectly elastic, frictionless contact of stiffness k.
+    pub fn hertz(stiffness: f64) -> Self {
+        ContactMaterial {
+            stiffness,
+            exponent: 1.5,
+            restitution: 1.0,
+            friction: 0.0,
+            stick_friction: 0.0,
+        }
+    }
+
+    /// Same material with another restitution coefficient.
+    pub fn with_restitution(mut self, restitution: f64) -> Self {
+        self.restitution = restitution;
+        self
+    }
+
+    /// Same material with sliding friction μ and sticking friction μ_s.
+    pub fn with_friction(mut self, friction: f64, stick_friction: f64) -> Self {
+        self.friction = friction;
+        self.stick_friction = stick_friction;
+        self
+    }
+
+    /// Same material with another exponent α.
+    pub fn with_exponent(mut self, exponent: f64) -> Self {
+        self.exponent = exponent;
+        self
+    }
+
+    /// Contact force as a function of stored energy (errata §1, the corrected
+    /// paper Eq. 26): F(E) = (α+1)^(α/(α+1)) k^(1/(α+1)) E^(α/(α+1)).
+    #[inline]
+    pub fn force_from_energy(&self, stored_energy: f64) -> f64 {
+        let a1 = self.exponent + 1.0;
+        let power = self.exponent / a1;
+        a1.powf(power) * self.stiffness.powf(1.0 / a1) * stored_energy.max(0.0).powf(power)
+    }
+}
+
+/// A contact point between two bodies, or between a body and the fixed world.
+///
+/// `bodies[0]` is the first body, `bodies[1]` the second; `None` is the fixed
+/// world. `normal` is a unit vector pointing from the first body to the second,
+/// so the normal relative velocity δ̇ = n·(v₂ − v₁) at the point is negative
+/// while the bodies approach. The tangent is the normal turned +90°:
+/// t = (−n_y, n_x).
+///
+/// ```
+/// use topple::impact::{Contact, ContactMaterial};
+/// // body 0 resting on the ground (the world is the first body, normal up)
+/// let c = Contact::new([None, Some(0)], [0.0, 0.0], [0.0, 1.0], ContactMaterial::hertz(1e9));
+/// assert_eq!(c.tangent(), [-1.0, 0.0]);
+/// ```
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Contact {
+    /// The two bodies (indices into the body slice); `None` is the fixed world.
+    pub bodies: [Option<usize>; 2],
+    /// Contact point in world coordinates (m).
+    pub point: [f64; 2],
+    /// Unit normal from the first body to the second.
+    pub normal: [f64; 2],
+    /// The contact law.
+    pub material: ContactMaterial,
+}
+
+impl Contact {
+    /// A contact with the given bodies, point, normal and material.
+    pub fn new(
+        bodies: [Option<usize>; 2],
+        point: [f64; 2],
+        normal: [f64; 2],
+        material: ContactMaterial,
+    ) -> Self {
+        Contact {
+            bodies,
+            point,
+            normal,
+            material,
+        }
+    }
+
+    /// Unit tangent t = (−n_y, n_x), the positive direction of tangential
+    /// impulses and velocities.
+    #[inline]
+    pub fn tangent(&self) -> [f64; 2] {
+        [-self.normal[1], self.normal[0]]
+    }
+}

@@ -1,0 +1,44 @@
+//! What an impact resolution returns.
+
+use serde::{Deserialize, Serialize};
+
+use super::body::BodyVelocity;
+
+/// Per-contact result of an impact.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct ContactImpulse {
+    /// Total normal impulse P_n ≥ 0 (N·s), acting on the second body along +n.
+    pub normal_impulse: f64,
+    /// Total tangential impulse P_t (N·s), acting on the second body along +t.
+    pub tangent_impulse: f64,
+    /// Largest potential energy E stored at the contact during the impact (J).
+    pub peak_energy: f64,
+}
+
+/// Why the resolver stopped.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub enum StopReason {
+    /// No closed contact was approaching: nothing to resolve.
+    NoApproach,
+    /// Every contact released its energy and none approaches any more.
+    Released,
+}
+
+/// Result of [`crate::impact::ImpactSolver::solve`].
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct ImpactOutcome {
+    /// Post-impact velocity of every body, in input order (fixed bodies keep 0).
+    pub bodies: Vec<BodyVelocity>,
+    /// Impulses and peak energy of every contact, in input order.
+    pub contacts: Vec<ContactImpulse>,
+    /// Kinetic energy of all bodies before the impact (J).
+    pub kinetic_energy_before: f64,
+    /// Kinetic energy of all bodies after the impact (J).
+    pub kinetic_energy_after: f64,
+    /// Impulse steps taken (accepted steps in adaptive mode).
+    pub steps: usize,
+    /// Steps rejected by the adaptive error control.
+    pub rejected_steps: usize,
+    /// Why the resolver stopped.
+    pub stop_reason: Option<StopReason>,
+}

@@ -1,0 +1,82 @@
+//! How the resolver steps through an impact.
+
+use serde::{Deserialize, Serialize};
+
+/// How the impulse variable is stepped.
+///
+/// ```
+/// use topple::impact::StepControl;
+/// let paper = StepControl::default();
+/// assert_eq!(paper, StepControl::Fixed { impulse_step: 1e-4 });
+/// let adaptive = StepControl::Adaptive { tolerance: 1e-6 };
+/// # let _ = adaptive;
+/// ```
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub enum StepControl {
+    /// The paper's scheme (Sec. 3.1): the primary contact advances by
+    /// ΔP = `impulse_step` · P₀ each step, P₀ being the magnitude of the linear
+    /// momentum of the free bodies just before the impact (their kinetic-energy
+    /// momentum scale when that is zero, see [`crate::impact::ImpactSolver`]).
+    Fixed {
+        /// ΔP / P₀, dimensionless; the paper uses 10⁻⁴.
+        impulse_step: f64,
+    },
+    /// Step-doubling with Richardson extrapolation and step-size control: each
+    /// accepted step keeps its local error (velocities relative to the largest
+    /// approach speed, energies relative to the kinetic energy) below
+    /// `tolerance` per unit of P₀.
+    Adaptive {
+        /// Relative error tolerance, dimensionless (e.g. 10⁻⁶).
+        tolerance: f64,
+    },
+}
+
+impl Default for StepControl {
+    fn default() -> Self {
+        StepControl::Fixed { impulse_step: 1e-4 }
+    }
+}
+
+/// Settings of one impact resolution.
+///
+/// ```
+/// use topple::impact::{ImpactSettings, StepControl};
+/// let s = ImpactSettings::adaptive(1e-6);
+/// assert_eq!(s.step_control, StepControl::Adaptive { tolerance: 1e-6 });
+/// assert!(s.max_steps > 0);
+/// ```
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct ImpactSettings {
+    /// Fixed or adaptive stepping.
+    pub step_control: StepControl,
+    /// A runaway impact stops with [`crate::impact::ImpactError::StepLimit`]
+    /// after this many steps (default 10⁷).
+    pub max_steps: usize,
+}
+
+impl Default for ImpactSettings {
+    fn default() -> Self {
+        ImpactSettings {
+            step_control: StepControl::default(),
+            max_steps: 10_000_000,
+        }
+    }
+}
+
+impl ImpactSettings {
+    /// The paper's fixed step ΔP = `impulse_step` · P₀.
+    pub fn fixed(impulse_step: f64) -> Self {
+        ImpactSettings {
+            step_control: StepControl::Fixed { impulse_step },
+            ..Default::default()
+        }
+    }
+
+    /// Adaptive stepping at the given relative tolerance.
+    pub fn adaptive(tolerance: f64) -> Self {
+        ImpactSettings {
+            step_control: StepControl::Adaptive { tolerance },
+            ..Default::default()
+        }
+    }
+}
