@@ -1,0 +1,310 @@
+//! Impact events and their groups, engine-agnostic: plain bodies and contact
+//! points at the current positions in, post-impact velocities out.
+//!
+//! A closed contact (gap ≤ tolerance) whose normal relative velocity
+//! δ̇ = n·(v₂ − v₁) is below −`min_approach_speed` starts an impact. The free
+//! bodies connected to it through closed contacts form its group (fixed bodies
+//! do not connect); every closed contact touching the group takes part. Each
+//! group is solved by the LZB resolver ([`crate::impact`]) and the new
+//! velocities are written back. A physics engine adapter (the rapier2d-f64 one
+//! in [`crate::rapier::ToppleRapier`], later a Bevy/f32 one) only has to fill
+//! the two slices.
+
+use crate::impact::{Body, Contact, ContactMaterial, ImpactError, ImpactSettings, ImpactSolver};
+
+use super::patch::PatchRule;
+
+/// A contact point between two bodies (indices into the body slice; `None` is
+/// the fixed world) at the current positions.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PointContact {
+    /// First and second body; the normal points from the first to the second.
+    pub bodies: [Option<usize>; 2],
+    /// Contact point, world frame (m).
+    pub point: [f64; 2],
+    /// Unit normal from the first body to the second.
+    pub normal: [f64; 2],
+    /// Signed gap (m); negative when penetrating.
+    pub dist: f64,
+    /// The contact law at this point.
+    pub material: ContactMaterial,
+}
+
+/// Settings of the impact pass.
+///
+/// ```
+/// use topple::rapier::ToppleSettings;
+/// let s = ToppleSettings::default();
+/// assert_eq!(s.patch.lambda, 9);
+/// ```
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ToppleSettings {
+    /// Settings handed to the LZB resolver (impulse step or tolerance).
+    pub impact: ImpactSettings,
+    /// Which manifold points are closed and how flat patches are subdivided.
+    pub patch: PatchRule,
+    /// A closed contact starts an impact when it approaches faster than this
+    /// (m/s). Slower approaches are left to the engine's contact solver.
+    pub min_approach_speed: f64,
+}
+
+impl Default for ToppleSettings {
+    fn default() -> Self {
+        ToppleSettings {
+            impact: ImpactSettings::default(),
+            patch: PatchRule::default(),
+            min_approach_speed: 1e-3,
+        }
+    }
+}
+
+/// What one resolved impact did.
+#[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize)]
+pub struct ImpactReport {
+    /// Free bodies in the group.
+    pub bodies: usize,
+    /// Contact points taking part (λ points counted one by one).
+    pub contacts: usize,
+    /// Fastest approach speed among the contacts that started it (m/s).
+    pub approach_speed: f64,
+    /// Kinetic energy of the group before and after (J).
+    pub kinetic_energy_before: f64,
+    /// Kinetic energy of the group after the impact (J).
+    pub kinetic_energy_after: f64,
+    /// Impulse steps taken by the resolver.
+    pub steps: usize,
+}
+
+const NONE: usize = usize::MAX;
+
+/// Finds impact groups and solves them; keeps every buffer between calls, so
+/// a steady scene allocates nothing.
+///
+/// ```
+/// use topple::impact::{Body, ContactMaterial};
+/// use topple::rapier::{ImpactGroups, PointContact, ToppleSettings};
+/// // two touching balls (r = 0.1 m), the first moving at 1 m/s
+/// let mut bodies = [
+///     Body::new(1.0, 0.004).with_velocity([1.0, 0.0]),
+///     Body::new(1.0, 0.004).with_position([0.2, 0.0]),
+/// ];
+/// let contacts = [PointContact {
+///     bodies: [Some(0), Some(1)], point: [0.1, 0.0], normal: [1.0, 0.0], dist: 0.0,
+///     material: ContactMaterial::hertz(1e8),
+/// }];
+/// let mut groups = ImpactGroups::default();
+/// let mut reports = Vec::new();
+/// # if groups.resolve(&mut bodies, &contacts, &ToppleSettings::default(), &mut reports).is_ok() {
+/// assert_eq!(reports.len(), 1);
+/// assert!((bodies[1].velocity[0] - 1.0).abs() < 1e-3);
+/// # }
+/// ```
+#[derive(Debug, Default)]
+pub struct ImpactGroups {
+    solver: ImpactSolver,
+    parent: Vec<usize>,
+    group_of_root: Vec<usize>,
+    seeds: Vec<(usize, f64)>,
+    body_start: Vec<usize>,
+    body_order: Vec<usize>,
+    contact_start: Vec<usize>,
+    contact_order: Vec<usize>,
+    group_speed: Vec<f64>,
+    cursor_b: Vec<usize>,
+    cursor_c: Vec<usize>,
+    local: Vec<usize>,
+    group_bodies: Vec<Body>,
+    group_contacts: Vec<Contact>,
+}
+
+#[inline]
+fn velocity_at(b: &Body, p: [f64; 2]) -> [f64; 2] {
+    let r = [p[0] - b.position[0], p[1] - b.position[1]];
+    [
+        b.velocity[0] - b.angular_velocity * r[1],
+        b.velocity[1] + b.angular_velocity * r[0],
+    ]
+}
+
+/// Normal relative velocity δ̇ = n·(v₂ − v₁) at a contact (m/s), negative
+/// while approaching.
+#[inline]
+pub fn normal_velocity(bodies: &[Body], c: &PointContact) -> f64 {
+    let v = |i: Option<usize>| match i {
+        Some(i) if !bodies[i].fixed => velocity_at(&bodies[i], c.point),
+        _ => [0.0, 0.0],
+    };
+    let (v1, v2) = (v(c.bodies[0]), v(c.bodies[1]));
+    c.normal[0] * (v2[0] - v1[0]) + c.normal[1] * (v2[1] - v1[1])
+}
+
+fn find(parent: &mut [usize], mut i: usize) -> usize {
+    while parent[i] != i {
+        parent[i] = parent[parent[i]];
+        i = parent[i];
+    }
+    i
+}
+
+impl ImpactGroups {
+    /// Resolves every impact found in `contacts` and writes the post-impact
+    /// velocities into `bodies`; appends one report per group to `reports` and
+    /// returns the number of groups. Bodies with `fixed` never move and do not
+    /// join groups.
+    pub fn resolve(
+        &mut self,
+        bodies: &mut [Body],
+        contacts: &[PointContact],
+        settings: &ToppleSettings,
+        reports: &mut Vec<ImpactReport>,
+    ) -> Result<usize, ImpactError> {
+        let tol = settings.patch.closed_tolerance;
+        let free = |i: Option<usize>, bodies: &[Body]| i.filter(|&i| !bodies[i].fixed);
+
+        // Seeds: closed contacts approaching fast enough. Nothing else is done
+        // when there are none (the common case).
+        self.seeds.clear();
+        for (k, c) in contacts.iter().enumerate() {
+            if c.dist <= tol {
+                let vn = normal_velocity(bodies, c);
+                if vn < -settings.min_approach_speed
+                    && (free(c.bodies[0], bodies).is_some() || free(c.bodies[1], bodies).is_some())
+                {
+                    self.seeds.push((k, -vn));
+                }
+            }
+        }
+        if self.seeds.is_empty() {
+            return Ok(0);
+        }
+
+        // Connected components of free bodies through closed contacts.
+        let n = bodies.len();
+        self.parent.clear();
+        self.parent.extend(0..n);
+        for c in contacts.iter().filter(|c| c.dist <= tol) {
+            if let (Some(a), Some(b)) = (free(c.bodies[0], bodies), free(c.bodies[1], bodies)) {
+                let (ra, rb) = (find(&mut self.parent, a), find(&mut self.parent, b));
+                if ra != rb {
+                    self.parent[ra.max(rb)] = ra.min(rb);
+                }
+            }
+        }
+        let root_of = |parent: &mut Vec<usize>, c: &PointContact, bodies: &[Body]| {
+            free(c.bodies[0], bodies)
+                .or(free(c.bodies[1], bodies))
+                .map(|i| find(parent, i))
+        };
+
+        // Number the seeded components in order of first seed (deterministic).
+        self.group_of_root.clear();
+        self.group_of_root.resize(n, NONE);
+        self.group_speed.clear();
+        for s in 0..self.seeds.len() {
+            let (k, speed) = self.seeds[s];
+            let r = root_of(&mut self.parent, &contacts[k], bodies).expect("seed has a free body");
+            if self.group_of_root[r] == NONE {
+                self.group_of_root[r] = self.group_speed.len();
+                self.group_speed.push(0.0);
+            }
+            let g = self.group_of_root[r];
+            self.group_speed[g] = self.group_speed[g].max(speed);
+        }
+        let groups = self.group_speed.len();
+
+        // Bucket bodies and closed contacts by group (counting sort).
+        self.body_start.clear();
+        self.body_start.resize(groups + 1, 0);
+        self.contact_start.clear();
+        self.contact_start.resize(groups + 1, 0);
+        for i in 0..n {
+            if !bodies[i].fixed {
+                let g = self.group_of_root[find(&mut self.parent, i)];
+                if g != NONE {
+                    self.body_start[g + 1] += 1;
+                }
+            }
+        }
+        for c in contacts.iter().filter(|c| c.dist <= tol) {
+            if let Some(r) = root_of(&mut self.parent, c, bodies) {
+                let g = self.group_of_root[r];
+                if g != NONE {
+                    self.contact_start[g + 1] += 1;
+                }
+            }
+        }
+        for g in 0..groups {
+            self.body_start[g + 1] += self.body_start[g];
+            self.contact_start[g + 1] += self.contact_start[g];
+        }
+        self.body_order.clear();
+        self.body_order.resize(self.body_start[groups], 0);
+        self.contact_order.clear();
+        self.contact_order.resize(self.contact_start[groups], 0);
+        {
+            // Fill, using copies of the start offsets as cursors.
+            self.cursor_b.clone_from(&self.body_start);
+            self.cursor_c.clone_from(&self.contact_start);
+            let (cursor_b, cursor_c) = (&mut self.cursor_b, &mut self.cursor_c);
+            for i in 0..n {
+                if !bodies[i].fixed {
+                    let g = self.group_of_root[find(&mut self.parent, i)];
+                    if g != NONE {
+                        self.body_order[cursor_b[g]] = i;
+                        cursor_b[g] += 1;
+                    }
+                }
+            }
+            for (k, c) in contacts.iter().enumerate().filter(|(_, c)| c.dist <= tol) {
+                if let Some(r) = root_of(&mut self.parent, c, bodies) {
+                    let g = self.group_of_root[r];
+                    if g != NONE {
+                        self.contact_order[cursor_c[g]] = k;
+                        cursor_c[g] += 1;
+                    }
+                }
+            }
+        }
+
+        // Solve each group.
+        self.local.clear();
+        self.local.resize(n, NONE);
+        for g in 0..groups {
+            self.group_bodies.clear();
+            for &i in &self.body_order[self.body_start[g]..self.body_start[g + 1]] {
+                self.local[i] = self.group_bodies.len();
+                self.group_bodies.push(bodies[i]);
+            }
+            self.group_contacts.clear();
+            for &k in &self.contact_order[self.contact_start[g]..self.contact_start[g + 1]] {
+                let c = &contacts[k];
+                let map = |i: Option<usize>| i.filter(|&i| !bodies[i].fixed).map(|i| self.local[i]);
+                self.group_contacts.push(Contact::new(
+                    [map(c.bodies[0]), map(c.bodies[1])],
+                    c.point,
+                    c.normal,
+                    c.material,
+                ));
+            }
+            let out =
+                self.solver
+                    .solve(&self.group_bodies, &self.group_contacts, &settings.impact)?;
+            for (&i, v) in self.body_order[self.body_start[g]..self.body_start[g + 1]]
+                .iter()
+                .zip(&out.bodies)
+            {
+                bodies[i].velocity = v.velocity;
+                bodies[i].angular_velocity = v.angular_velocity;
+            }
+            reports.push(ImpactReport {
+                bodies: self.group_bodies.len(),
+                contacts: self.group_contacts.len(),
+                approach_speed: self.group_speed[g],
+                kinetic_energy_before: out.kinetic_energy_before,
+                kinetic_energy_after: out.kinetic_energy_after,
+                steps: out.steps,
+            });
+        }
+        Ok(groups)
+    }
+}

@@ -1,0 +1,327 @@
+//! The rapier2d-f64 adapter: reads the current state of a Rapier world into
+//! plain data, lets [`ImpactGroups`] resolve the impacts, writes velocities
+//! back. Everything physical lives in the engine-agnostic modules.
+
+use rapier2d_f64::parry::query::{
+    ContactManifold, DefaultQueryDispatcher, PersistentQueryDispatcher,
+};
+use rapier2d_f64::prelude::{
+    ActiveHooks, ColliderHandle, ColliderSet, NarrowPhase, PhysicsWorld, RigidBodyHandle,
+    RigidBodySet, Vector,
+};
+
+use crate::impact::{Body, ImpactError};
+
+use super::group::{ImpactGroups, ImpactReport, PointContact, ToppleSettings};
+use super::hooks::{HookMode, ToppleHooks};
+use super::material::{MaterialId, PairMaterial};
+use super::patch::{for_each_contact_point, ManifoldPoint};
+
+/// Running totals over all resolve passes.
+#[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize)]
+pub struct ToppleStats {
+    /// Candidate pairs queried at the current positions.
+    pub pairs_queried: u64,
+    /// Closed contact points found (λ points counted one by one).
+    pub contact_points: u64,
+    /// Impacts resolved.
+    pub impacts: u64,
+    /// Resolver impulse steps, summed.
+    pub impulse_steps: u64,
+}
+
+/// LZB impacts for a rapier2d-f64 world.
+///
+/// Register the colliders topple manages with a material; step the world
+/// with [`ToppleRapier::step`] (or run your own `PhysicsPipeline::step` with
+/// [`ToppleRapier::hooks`] and call [`ToppleRapier::resolve_impacts`] after
+/// it). Pairs of managed colliders get their impacts from the LZB resolver;
+/// everything else is plain Rapier.
+///
+/// ```
+/// use rapier2d_f64::prelude::*;
+/// use topple::impact::ContactMaterial;
+/// use topple::rapier::{PairMaterial, ToppleRapier, ToppleSettings};
+///
+/// let mut world = PhysicsWorld::default();
+/// world.gravity = Vector::ZERO;
+/// let mut topple = ToppleRapier::new(ToppleSettings::default());
+/// let steel = topple.add_material(PairMaterial {
+///     impact: ContactMaterial::hertz(1e10),
+///     smooth_friction: 0.0,
+/// });
+/// // a cradle of two touching balls, the first moving at 1 m/s
+/// let mut balls = Vec::new();
+/// for (x, v) in [(0.0, 1.0), (0.2, 0.0)] {
+///     let (body, collider) = world.insert(
+///         RigidBodyBuilder::dynamic().translation(Vector::new(x, 0.0)).linvel(Vector::new(v, 0.0)),
+///         ColliderBuilder::ball(0.1),
+///     );
+///     topple.manage(&mut world.colliders, collider, steel);
+///     balls.push(body);
+/// }
+/// # if topple.step(&mut world).is_ok() {
+/// assert!(world.bodies[balls[0]].linvel().x.abs() < 1e-3);
+/// assert!((world.bodies[balls[1]].linvel().x - 1.0).abs() < 1e-3);
+/// # }
+/// ```
+#[derive(Debug)]
+pub struct ToppleRapier {
+    hooks: ToppleHooks,
+    /// Settings of the impact pass (may be changed between steps).
+    pub settings: ToppleSettings,
+    groups: ImpactGroups,
+    bodies: Vec<Body>,
+    handles: Vec<RigidBodyHandle>,
+    slot: Vec<u32>,
+    contacts: Vec<PointContact>,
+    manifold: ContactManifold<(), ()>,
+    points: Vec<ManifoldPoint>,
+    reports: Vec<ImpactReport>,
+    stats: ToppleStats,
+    resolved_initial: bool,
+}
+
+const NO_SLOT: u32 = u32::MAX;
+
+fn v2(v: Vector) -> [f64; 2] {
+    [v.x, v.y]
+}
+
+impl ToppleRapier {
+    /// topple resolving impacts with the given settings.
+    pub fn new(settings: ToppleSettings) -> Self {
+        Self::with_mode(settings, HookMode::Topple)
+    }
+
+    /// A native-Rapier twin: the same per-pair friction and restitution, but
+    /// Rapier resolves impacts and [`ToppleRapier::resolve_impacts`] does
+    /// nothing. For comparisons.
+    pub fn native() -> Self {
+        Self::with_mode(ToppleSettings::default(), HookMode::Native)
+    }
+
+    fn with_mode(settings: ToppleSettings, mode: HookMode) -> Self {
+        ToppleRapier {
+            hooks: ToppleHooks::new(mode),
+            settings,
+            groups: ImpactGroups::default(),
+            bodies: Vec::new(),
+            handles: Vec::new(),
+            slot: Vec::new(),
+            contacts: Vec::new(),
+            manifold: ContactManifold::new(),
+            points: Vec::new(),
+            reports: Vec::new(),
+            stats: ToppleStats::default(),
+            resolved_initial: false,
+        }
+    }
+
+    /// Adds a material; returns its id.
+    pub fn add_material(&mut self, material: PairMaterial) -> MaterialId {
+        self.hooks.table.add(material)
+    }
+
+    /// Sets the material between colliders of materials `a` and `b`.
+    pub fn set_pair_material(&mut self, a: MaterialId, b: MaterialId, material: PairMaterial) {
+        self.hooks.table.set_pair(a, b, material);
+    }
+
+    /// Lets topple manage a collider with the given material (and turns on
+    /// the collider's contact-modification hook).
+    pub fn manage(
+        &mut self,
+        colliders: &mut ColliderSet,
+        collider: ColliderHandle,
+        material: MaterialId,
+    ) {
+        assert!(
+            (material.0 as usize) < self.hooks.table.len(),
+            "unknown material"
+        );
+        self.hooks.set(collider, material);
+        let co = &mut colliders[collider];
+        co.set_active_hooks(co.active_hooks() | ActiveHooks::MODIFY_SOLVER_CONTACTS);
+    }
+
+    /// The hooks to hand to `PhysicsPipeline::step`.
+    pub fn hooks(&self) -> &ToppleHooks {
+        &self.hooks
+    }
+
+    /// Impacts resolved by the last [`ToppleRapier::resolve_impacts`].
+    pub fn last_impacts(&self) -> &[ImpactReport] {
+        &self.reports
+    }
+
+    /// Totals since creation.
+    pub fn stats(&self) -> ToppleStats {
+        self.stats
+    }
+
+    /// One step of a [`PhysicsWorld`]: impacts present before the first step
+    /// are resolved first; then Rapier steps with topple's hooks and the
+    /// impacts at the new positions are resolved. Returns the number of
+    /// impacts resolved after the step.
+    pub fn step(&mut self, world: &mut PhysicsWorld) -> Result<usize, ImpactError> {
+        if !self.resolved_initial {
+            self.resolve_impacts(&mut world.bodies, &world.colliders, &world.narrow_phase)?;
+            self.resolved_initial = true;
+        }
+        world.step_with_events(&self.hooks, &());
+        self.resolve_impacts(&mut world.bodies, &world.colliders, &world.narrow_phase)
+    }
+
+    fn slot_of(&mut self, bodies: &RigidBodySet, handle: Option<RigidBodyHandle>) -> Option<usize> {
+        let h = handle?;
+        let rb = &bodies[h];
+        if !rb.is_dynamic() {
+            return None; // fixed and kinematic bodies act as the fixed world
+        }
+        let i = h.into_raw_parts().0 as usize;
+        if self.slot.len() <= i {
+            self.slot.resize(i + 1, NO_SLOT);
+        }
+        if self.slot[i] == NO_SLOT {
+            self.slot[i] = self.bodies.len() as u32;
+            let inv_i = rb.mass_properties().effective_world_inv_inertia;
+            self.bodies.push(Body {
+                mass: rb.mass(),
+                inertia: if inv_i > 0.0 {
+                    1.0 / inv_i
+                } else {
+                    f64::INFINITY
+                },
+                position: v2(rb.center_of_mass()),
+                angle: rb.rotation().angle(),
+                velocity: v2(rb.linvel()),
+                angular_velocity: rb.angvel(),
+                fixed: false,
+            });
+            self.handles.push(h);
+        }
+        Some(self.slot[i] as usize)
+    }
+
+    /// Resolves the impacts at the current positions of a Rapier world and
+    /// writes the post-impact velocities back (waking the bodies). Only pairs
+    /// in Rapier's contact graph with at least one awake dynamic body and both
+    /// colliders managed are queried; pairs of non-convex shapes are skipped.
+    /// Returns the number of impacts resolved.
+    pub fn resolve_impacts(
+        &mut self,
+        bodies: &mut RigidBodySet,
+        colliders: &ColliderSet,
+        narrow_phase: &NarrowPhase,
+    ) -> Result<usize, ImpactError> {
+        self.reports.clear();
+        if self.hooks.mode == HookMode::Native {
+            return Ok(0);
+        }
+        self.bodies.clear();
+        self.handles.clear();
+        self.contacts.clear();
+        let rule = self.settings.patch;
+        let prediction = rule.closed_tolerance.max(0.0);
+        let dispatcher = DefaultQueryDispatcher;
+        for pair in narrow_phase.contact_pairs() {
+            let Some(material) = self.hooks.pair(pair.collider1, pair.collider2) else {
+                continue;
+            };
+            let material = material.impact;
+            let (Some(co1), Some(co2)) =
+                (colliders.get(pair.collider1), colliders.get(pair.collider2))
+            else {
+                continue;
+            };
+            let awake = |h: Option<RigidBodyHandle>| {
+                h.and_then(|h| bodies.get(h))
+                    .is_some_and(|rb| rb.is_dynamic() && !rb.is_sleeping())
+            };
+            if !awake(co1.parent()) && !awake(co2.parent()) {
+                continue;
+            }
+            if !(co1.shape().is_convex() && co2.shape().is_convex()) {
+                continue;
+            }
+            self.stats.pairs_queried += 1;
+            let (pos1, pos2) = (co1.position(), co2.position());
+            let pos12 = pos1.inv_mul(pos2);
+            self.manifold.clear();
+            if dispatcher
+                .contact_manifold_convex_convex(
+                    &pos12,
+                    co1.shape(),
+                    co2.shape(),
+                    None,
+                    None,
+                    prediction,
+                    &mut self.manifold,
+                )
+                .is_err()
+            {
+                continue;
+            }
+            if self.manifold.points.is_empty() {
+                continue;
+            }
+            let normal = v2(pos1.transform_vector(self.manifold.local_n1).normalize());
+            self.points.clear();
+            for p in &self.manifold.points {
+                let a = pos1.transform_point(p.local_p1);
+                let b = pos2.transform_point(p.local_p2);
+                self.points.push(ManifoldPoint {
+                    point: [0.5 * (a.x + b.x), 0.5 * (a.y + b.y)],
+                    dist: p.dist,
+                });
+            }
+            if !self.points.iter().any(|p| p.dist <= rule.closed_tolerance) {
+                continue;
+            }
+            let b1 = self.slot_of(bodies, co1.parent());
+            let b2 = self.slot_of(bodies, co2.parent());
+            if b1.is_none() && b2.is_none() {
+                continue;
+            }
+            let contacts = &mut self.contacts;
+            for_each_contact_point(&self.points, &rule, |point, dist| {
+                contacts.push(PointContact {
+                    bodies: [b1, b2],
+                    point,
+                    normal,
+                    dist,
+                    material,
+                })
+            });
+        }
+        self.stats.contact_points += self.contacts.len() as u64;
+        let result = self.groups.resolve(
+            &mut self.bodies,
+            &self.contacts,
+            &self.settings,
+            &mut self.reports,
+        );
+        // Reset the slot map (only the entries used), then write back.
+        for h in &self.handles {
+            self.slot[h.into_raw_parts().0 as usize] = NO_SLOT;
+        }
+        let groups = result?;
+        if groups > 0 {
+            for (h, b) in self.handles.iter().zip(&self.bodies) {
+                let rb = &mut bodies[*h];
+                let (v, w) = (
+                    Vector::new(b.velocity[0], b.velocity[1]),
+                    b.angular_velocity,
+                );
+                if rb.linvel() != v || rb.angvel() != w {
+                    rb.set_linvel(v, true);
+                    rb.set_angvel(w, true);
+                }
+            }
+            self.stats.impacts += groups as u64;
+            self.stats.impulse_steps += self.reports.iter().map(|r| r.steps as u64).sum::<u64>();
+        }
+        Ok(groups)
+    }
+}
