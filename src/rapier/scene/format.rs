@@ -1,0 +1,249 @@
+//! The TOML scene format (serde). Units: m, kg, s, rad. See the README
+//! section "Rapier plugin (`topple scene`)" for a commented example.
+
+use serde::{Deserialize, Serialize};
+
+/// A whole scene.
+///
+/// ```
+/// let scene: topple::rapier::scene::Scene = toml::from_str(r#"
+///     duration = 1.0
+///     [[materials]]
+///     name = "steel"
+///     stiffness = 1e10
+///     [[bodies]]
+///     shape = "ball"
+///     radius = 0.05
+///     position = [0.0, 1.0]
+///     material = "steel"
+/// "#).unwrap();
+/// assert_eq!(scene.bodies.len(), 1);
+/// assert_eq!(scene.gravity, [0.0, -9.81]);
+/// ```
+#[derive(Clone, Debug, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Scene {
+    /// What the scene shows (free text).
+    #[serde(default)]
+    pub description: String,
+    /// Simulated time (s).
+    pub duration: f64,
+    /// Gravity (m/s²).
+    #[serde(default = "default_gravity")]
+    pub gravity: [f64; 2],
+    /// Integrator and impact-solver settings.
+    #[serde(default)]
+    pub solver: SolverSpec,
+    /// Materials by name.
+    #[serde(default)]
+    pub materials: Vec<MaterialSpec>,
+    /// Per-pair overrides.
+    #[serde(default)]
+    pub pairs: Vec<PairSpec>,
+    /// A fixed ground (top face at `y`).
+    #[serde(default)]
+    pub ground: Option<GroundSpec>,
+    /// Bodies.
+    #[serde(default)]
+    pub bodies: Vec<BodySpec>,
+    /// A generated domino row (adds its blocks, materials, pair rules and ground).
+    #[serde(default)]
+    pub row: Option<RowSpec>,
+}
+
+fn default_gravity() -> [f64; 2] {
+    [0.0, -9.81]
+}
+
+/// Time stepping and impact resolution.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct SolverSpec {
+    /// Rapier time step (s).
+    pub dt: f64,
+    /// Rapier's length unit (m): scales its slop, prediction distance and
+    /// corrective velocities; set it to a typical body size.
+    pub length_unit: f64,
+    /// Rapier solver iterations per step.
+    pub iterations: usize,
+    /// Rapier's contact recycling (pairs with hooks are never recycled).
+    pub contact_recycling: bool,
+    /// Fixed impulse step ΔP/P₀ of the LZB resolver (the paper: 10⁻⁴).
+    pub impulse_step: f64,
+    /// Adaptive impulse stepping with this tolerance instead (if set).
+    pub tolerance: Option<f64>,
+    /// λ points across a flat contact patch.
+    pub lambda: usize,
+    /// Approach speed (m/s) above which a closed contact starts an impact.
+    pub min_approach_speed: f64,
+    /// Gap (m) at or below which a contact point is closed.
+    pub closed_tolerance: f64,
+}
+
+impl Default for SolverSpec {
+    fn default() -> Self {
+        SolverSpec {
+            dt: 1e-3,
+            length_unit: 1.0,
+            iterations: 4,
+            contact_recycling: true,
+            impulse_step: 1e-4,
+            tolerance: None,
+            lambda: 9,
+            min_approach_speed: 1e-3,
+            closed_tolerance: 0.0,
+        }
+    }
+}
+
+/// A named material: contact law for impacts, friction for both phases.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MaterialSpec {
+    /// Name used by bodies and pairs.
+    pub name: String,
+    /// Contact stiffness k (N/m^α); only ratios matter.
+    pub stiffness: f64,
+    /// Exponent α of F = k δ^α.
+    #[serde(default = "default_exponent")]
+    pub exponent: f64,
+    /// Energetic restitution e ∈ [0, 1].
+    #[serde(default = "one")]
+    pub restitution: f64,
+    /// Sliding friction μ of the smooth phase.
+    #[serde(default)]
+    pub friction: f64,
+    /// Sticking friction μ_s inside impacts.
+    #[serde(default)]
+    pub stick_friction: f64,
+    /// Factor on μ inside impacts (the paper's presets: 0.5).
+    #[serde(default = "one")]
+    pub impact_friction_factor: f64,
+}
+
+fn default_exponent() -> f64 {
+    1.5
+}
+fn one() -> f64 {
+    1.0
+}
+
+/// A pair rule: the material between two named materials.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PairSpec {
+    /// The two material names (either order).
+    pub materials: [String; 2],
+    /// The law between them (its `name` is ignored).
+    #[serde(flatten)]
+    pub law: PairLaw,
+}
+
+/// The law of a pair rule.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct PairLaw {
+    /// Contact stiffness k (N/m^α).
+    pub stiffness: f64,
+    /// Exponent α.
+    #[serde(default = "default_exponent")]
+    pub exponent: f64,
+    /// Restitution e.
+    #[serde(default = "one")]
+    pub restitution: f64,
+    /// Sliding friction μ.
+    #[serde(default)]
+    pub friction: f64,
+    /// Sticking friction μ_s.
+    #[serde(default)]
+    pub stick_friction: f64,
+    /// Factor on μ inside impacts.
+    #[serde(default = "one")]
+    pub impact_friction_factor: f64,
+}
+
+/// The ground: a fixed slab whose top face is at height `y`.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct GroundSpec {
+    /// Height of the top face (m).
+    #[serde(default)]
+    pub y: f64,
+    /// Material name.
+    pub material: String,
+}
+
+/// Shape of a body.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum ShapeKind {
+    /// A rectangle of `size` = [width, height].
+    Box,
+    /// A disc of `radius`.
+    Ball,
+}
+
+/// One body.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct BodySpec {
+    /// Name in the output (default: its index).
+    #[serde(default)]
+    pub name: Option<String>,
+    /// Box or ball.
+    pub shape: ShapeKind,
+    /// Box full size [width, height] (m).
+    #[serde(default)]
+    pub size: Option<[f64; 2]>,
+    /// Ball radius (m).
+    #[serde(default)]
+    pub radius: Option<f64>,
+    /// Centre (m).
+    pub position: [f64; 2],
+    /// Angle (rad, counter-clockwise).
+    #[serde(default)]
+    pub angle: f64,
+    /// Velocity of the centre (m/s).
+    #[serde(default)]
+    pub velocity: [f64; 2],
+    /// Angular velocity (rad/s, counter-clockwise).
+    #[serde(default)]
+    pub angular_velocity: f64,
+    /// Density (kg/m², per unit depth); default 1000 unless `mass` is given.
+    #[serde(default)]
+    pub density: Option<f64>,
+    /// Mass (kg); overrides density.
+    #[serde(default)]
+    pub mass: Option<f64>,
+    /// A fixed body never moves.
+    #[serde(default)]
+    pub fixed: bool,
+    /// Material name.
+    pub material: String,
+}
+
+/// A domino row on the ground (paper Sec. 3): blocks standing at spacing s,
+/// the first pushed about its front bottom edge.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RowSpec {
+    /// Table 1 preset: "X", "T" or "P".
+    pub preset: String,
+    /// Number of blocks.
+    pub n: usize,
+    /// Spacing s/h (gap between faces over height).
+    pub spacing: f64,
+    /// Push: the first block's dimensionless angular velocity θ̇₁ t̄ about its
+    /// front bottom edge, t̄ = √(h/g).
+    #[serde(default = "one")]
+    pub push: f64,
+    /// The ideal parameters μ₁ = 0, e₁ = 0, μ₂ = 0.9, e₂ = 0 (paper Fig. 5).
+    #[serde(default)]
+    pub ideal: bool,
+    /// Block density (kg/m² per unit depth).
+    #[serde(default = "default_density")]
+    pub density: f64,
+}
+
+fn default_density() -> f64 {
+    1000.0
+}
