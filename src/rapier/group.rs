@@ -217,8 +217,8 @@ impl ImpactGroups {
         self.body_start.resize(groups + 1, 0);
         self.contact_start.clear();
         self.contact_start.resize(groups + 1, 0);
-        for i in 0..n {
-            if !bodies[i].fixed {
+        for (i, b) in bodies.iter().enumerate() {
+            if !b.fixed {
                 let g = self.group_of_root[find(&mut self.parent, i)];
                 if g != NONE {
                     self.body_start[g + 1] += 1;
@@ -246,8 +246,8 @@ impl ImpactGroups {
             self.cursor_b.clone_from(&self.body_start);
             self.cursor_c.clone_from(&self.contact_start);
             let (cursor_b, cursor_c) = (&mut self.cursor_b, &mut self.cursor_c);
-            for i in 0..n {
-                if !bodies[i].fixed {
+            for (i, b) in bodies.iter().enumerate() {
+                if !b.fixed {
                     let g = self.group_of_root[find(&mut self.parent, i)];
                     if g != NONE {
                         self.body_order[cursor_b[g]] = i;

@@ -105,14 +105,16 @@ pub fn build(scene: &Scene, engine: Engine) -> anyhow::Result<SceneWorld> {
     if !(s.dt > 0.0 && s.length_unit > 0.0 && scene.duration >= 0.0) {
         bail!("dt and length_unit must be > 0 and duration >= 0");
     }
-    let mut world = PhysicsWorld::default();
-    world.gravity = Vector::new(scene.gravity[0], scene.gravity[1]);
-    world.integration_parameters = IntegrationParameters {
-        dt: s.dt,
-        length_unit: s.length_unit,
-        num_solver_iterations: s.iterations.max(1),
-        contact_recycling: s.contact_recycling,
-        ..IntegrationParameters::default()
+    let mut world = PhysicsWorld {
+        gravity: Vector::new(scene.gravity[0], scene.gravity[1]),
+        integration_parameters: IntegrationParameters {
+            dt: s.dt,
+            length_unit: s.length_unit,
+            num_solver_iterations: s.iterations.max(1),
+            contact_recycling: s.contact_recycling,
+            ..IntegrationParameters::default()
+        },
+        ..PhysicsWorld::default()
     };
     let mut topple = match engine {
         Engine::Rapier => ToppleRapier::new(topple_settings(s)),
