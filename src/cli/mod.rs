@@ -7,7 +7,11 @@ use clap::{Parser, Subcommand};
 mod impact;
 
 #[derive(Parser)]
-#[command(name = "topple", version, about = "LZB multiple impacts for dominoes, Rapier and Bevy")]
+#[command(
+    name = "topple",
+    version,
+    about = "LZB multiple impacts for dominoes, Rapier and Bevy"
+)]
 struct Cli {
     #[command(subcommand)]
     command: Command,
