@@ -1,8 +1,11 @@
 //! Impact events and their groups, engine-agnostic: plain bodies and contact
 //! points at the current positions in, post-impact velocities out.
 //!
-//! A closed contact (gap ≤ tolerance) whose normal relative velocity
-//! δ̇ = n·(v₂ − v₁) is below −`min_approach_speed` starts an impact. The free
+//! A closed contact (gap ≤ tolerance) of a pair that was not closed at the
+//! previous pass, whose normal relative velocity δ̇ = n·(v₂ − v₁) is below
+//! −`min_approach_speed`, starts an impact. (In discrete time a persistent
+//! sliding contact shows small spurious approaches of order g·Δt and
+//! v_t·ω·Δt; those are the engine's contact solver's business.) The free
 //! bodies connected to it through closed contacts form its group (fixed bodies
 //! do not connect); every closed contact touching the group takes part. Each
 //! group is solved by the LZB resolver ([`crate::impact`]) and the new
@@ -28,6 +31,10 @@ pub struct PointContact {
     pub dist: f64,
     /// The contact law at this point.
     pub material: ContactMaterial,
+    /// The pair was already in closed contact at the previous pass: a
+    /// persistent (resting or sliding) contact never starts an impact, though
+    /// it takes part in one that another contact starts.
+    pub persistent: bool,
 }
 
 /// Settings of the impact pass.
@@ -43,9 +50,16 @@ pub struct ToppleSettings {
     pub impact: ImpactSettings,
     /// Which manifold points are closed and how flat patches are subdivided.
     pub patch: PatchRule,
-    /// A closed contact starts an impact when it approaches faster than this
-    /// (m/s). Slower approaches are left to the engine's contact solver.
+    /// A new closed contact starts an impact when it approaches faster than
+    /// this (m/s). Slower approaches are left to the engine's contact solver.
+    /// Keep it above about 2|g|Δt, the approach a resting contact picks up in
+    /// one step.
     pub min_approach_speed: f64,
+    /// The window of an impact: only free bodies within this many closed
+    /// contacts of the bodies that started it take part; the others act as
+    /// the fixed world (like the paper's active window κ). `None`: the whole
+    /// connected group.
+    pub max_group_hops: Option<usize>,
 }
 
 impl Default for ToppleSettings {
@@ -54,6 +68,7 @@ impl Default for ToppleSettings {
             impact: ImpactSettings::default(),
             patch: PatchRule::default(),
             min_approach_speed: 1e-3,
+            max_group_hops: None,
         }
     }
 }
@@ -90,7 +105,7 @@ const NONE: usize = usize::MAX;
 /// ];
 /// let contacts = [PointContact {
 ///     bodies: [Some(0), Some(1)], point: [0.1, 0.0], normal: [1.0, 0.0], dist: 0.0,
-///     material: ContactMaterial::hertz(1e8),
+///     material: ContactMaterial::hertz(1e8), persistent: false,
 /// }];
 /// let mut groups = ImpactGroups::default();
 /// let mut reports = Vec::new();
@@ -111,6 +126,11 @@ pub struct ImpactGroups {
     contact_order: Vec<usize>,
     group_speed: Vec<f64>,
     cursor_b: Vec<usize>,
+    inside: Vec<bool>,
+    adj_start: Vec<usize>,
+    adj: Vec<usize>,
+    depth: Vec<usize>,
+    queue: Vec<usize>,
     cursor_c: Vec<usize>,
     local: Vec<usize>,
     group_bodies: Vec<Body>,
@@ -160,12 +180,13 @@ impl ImpactGroups {
     ) -> Result<usize, ImpactError> {
         let tol = settings.patch.closed_tolerance;
         let free = |i: Option<usize>, bodies: &[Body]| i.filter(|&i| !bodies[i].fixed);
+        let n = bodies.len();
 
         // Seeds: closed contacts approaching fast enough. Nothing else is done
         // when there are none (the common case).
         self.seeds.clear();
         for (k, c) in contacts.iter().enumerate() {
-            if c.dist <= tol {
+            if c.dist <= tol && !c.persistent {
                 let vn = normal_velocity(bodies, c);
                 if vn < -settings.min_approach_speed
                     && (free(c.bodies[0], bodies).is_some() || free(c.bodies[1], bodies).is_some())
@@ -178,8 +199,64 @@ impl ImpactGroups {
             return Ok(0);
         }
 
+        // The window: free bodies within `max_group_hops` closed contacts of a
+        // body of a seed contact; those outside act as the fixed world.
+        self.inside.clear();
+        self.inside.resize(n, settings.max_group_hops.is_none());
+        if let Some(hops) = settings.max_group_hops {
+            self.adj_start.clear();
+            self.adj_start.resize(n + 1, 0);
+            for c in contacts.iter().filter(|c| c.dist <= tol) {
+                if let (Some(a), Some(b)) = (free(c.bodies[0], bodies), free(c.bodies[1], bodies)) {
+                    self.adj_start[a + 1] += 1;
+                    self.adj_start[b + 1] += 1;
+                }
+            }
+            for i in 0..n {
+                self.adj_start[i + 1] += self.adj_start[i];
+            }
+            self.adj.clear();
+            self.adj.resize(self.adj_start[n], 0);
+            self.cursor_b.clone_from(&self.adj_start);
+            for c in contacts.iter().filter(|c| c.dist <= tol) {
+                if let (Some(a), Some(b)) = (free(c.bodies[0], bodies), free(c.bodies[1], bodies)) {
+                    self.adj[self.cursor_b[a]] = b;
+                    self.cursor_b[a] += 1;
+                    self.adj[self.cursor_b[b]] = a;
+                    self.cursor_b[b] += 1;
+                }
+            }
+            self.depth.clear();
+            self.depth.resize(n, NONE);
+            self.queue.clear();
+            for &(k, _) in &self.seeds {
+                for i in contacts[k].bodies.iter().filter_map(|&i| free(i, bodies)) {
+                    if self.depth[i] == NONE {
+                        self.depth[i] = 0;
+                        self.queue.push(i);
+                    }
+                }
+            }
+            let mut head = 0;
+            while head < self.queue.len() {
+                let i = self.queue[head];
+                head += 1;
+                self.inside[i] = true;
+                if self.depth[i] < hops {
+                    for a in self.adj_start[i]..self.adj_start[i + 1] {
+                        let j = self.adj[a];
+                        if self.depth[j] == NONE {
+                            self.depth[j] = self.depth[i] + 1;
+                            self.queue.push(j);
+                        }
+                    }
+                }
+            }
+        }
+        let inside = &self.inside;
+        let free = |i: Option<usize>, bodies: &[Body]| i.filter(|&i| !bodies[i].fixed && inside[i]);
+
         // Connected components of free bodies through closed contacts.
-        let n = bodies.len();
         self.parent.clear();
         self.parent.extend(0..n);
         for c in contacts.iter().filter(|c| c.dist <= tol) {
@@ -218,7 +295,7 @@ impl ImpactGroups {
         self.contact_start.clear();
         self.contact_start.resize(groups + 1, 0);
         for (i, b) in bodies.iter().enumerate() {
-            if !b.fixed {
+            if !b.fixed && inside[i] {
                 let g = self.group_of_root[find(&mut self.parent, i)];
                 if g != NONE {
                     self.body_start[g + 1] += 1;
@@ -247,7 +324,7 @@ impl ImpactGroups {
             self.cursor_c.clone_from(&self.contact_start);
             let (cursor_b, cursor_c) = (&mut self.cursor_b, &mut self.cursor_c);
             for (i, b) in bodies.iter().enumerate() {
-                if !b.fixed {
+                if !b.fixed && inside[i] {
                     let g = self.group_of_root[find(&mut self.parent, i)];
                     if g != NONE {
                         self.body_order[cursor_b[g]] = i;
@@ -278,7 +355,7 @@ impl ImpactGroups {
             self.group_contacts.clear();
             for &k in &self.contact_order[self.contact_start[g]..self.contact_start[g + 1]] {
                 let c = &contacts[k];
-                let map = |i: Option<usize>| i.filter(|&i| !bodies[i].fixed).map(|i| self.local[i]);
+                let map = |i: Option<usize>| free(i, bodies).map(|i| self.local[i]);
                 self.group_contacts.push(Contact::new(
                     [map(c.bodies[0]), map(c.bodies[1])],
                     c.point,
@@ -286,9 +363,10 @@ impl ImpactGroups {
                     c.material,
                 ));
             }
-            let out =
-                self.solver
-                    .solve(&self.group_bodies, &self.group_contacts, &settings.impact)?;
+            let out = self
+                .solver
+                .solve(&self.group_bodies, &self.group_contacts, &settings.impact);
+            let out = out?;
             for (&i, v) in self.body_order[self.body_start[g]..self.body_start[g + 1]]
                 .iter()
                 .zip(&out.bodies)

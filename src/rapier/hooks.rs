@@ -2,7 +2,9 @@
 //! restitution switched off and its speculative contacts dropped on the pairs
 //! topple manages, so that no impact is counted twice.
 
-use rapier2d_f64::prelude::{ColliderHandle, ContactModificationContext, PhysicsHooks};
+use rapier2d_f64::prelude::{
+    ColliderHandle, ContactModificationContext, PhysicsHooks, RigidBodyHandle, Vector,
+};
 
 use super::material::{MaterialId, MaterialTable, PairMaterial};
 
@@ -10,8 +12,9 @@ use super::material::{MaterialId, MaterialTable, PairMaterial};
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum HookMode {
     /// topple resolves impacts; Rapier keeps resting contact with restitution 0
-    /// and without speculative (still open) contact points, which would stop an
-    /// approaching pair inelastically at the moment it touches.
+    /// and without the contact points that are still open (speculative) or
+    /// approach faster than topple's impact threshold: Rapier would stop those
+    /// inelastically at the moment of touching, before topple sees them.
     Topple,
     /// Rapier resolves impacts itself with the pair's restitution; the hook
     /// only sets friction and restitution per pair (native Rapier response).
@@ -24,6 +27,9 @@ pub struct ToppleHooks {
     pub(crate) table: MaterialTable,
     collider_material: Vec<u16>,
     pub(crate) mode: HookMode,
+    pub(crate) min_approach_speed: f64,
+    /// Pairs closed at the last resolve pass, sorted (see [`super::pair_key`]).
+    closed: Vec<u64>,
 }
 
 const UNMANAGED: u16 = u16::MAX;
@@ -34,6 +40,8 @@ impl ToppleHooks {
             table: MaterialTable::default(),
             collider_material: Vec::new(),
             mode,
+            min_approach_speed: 0.0,
+            closed: Vec::new(),
         }
     }
 
@@ -43,6 +51,25 @@ impl ToppleHooks {
             self.collider_material.resize(i + 1, UNMANAGED);
         }
         self.collider_material[i] = material.0;
+    }
+
+    /// Was this pair closed at the last resolve pass?
+    #[inline]
+    pub(crate) fn was_closed(&self, key: u64) -> bool {
+        self.closed.binary_search(&key).is_ok()
+    }
+
+    /// Makes `now` (the pairs closed at this pass) the persistent set, adding
+    /// the previously closed pairs for which `skipped` holds (not queried).
+    pub(crate) fn keep_sleeping_closed(
+        &mut self,
+        now: &mut Vec<u64>,
+        skipped: impl Fn(u64) -> bool,
+    ) {
+        now.extend(self.closed.iter().copied().filter(|&k| skipped(k)));
+        now.sort_unstable();
+        now.dedup();
+        std::mem::swap(&mut self.closed, now);
     }
 
     /// The material of a collider, if topple manages it.
@@ -73,7 +100,23 @@ impl PhysicsHooks for ToppleHooks {
         match self.mode {
             HookMode::Topple => {
                 *context.restitution = 0.0;
-                context.solver_contacts.retain(|c| c.dist <= 0.0);
+                let n = *context.normal;
+                let bodies = context.bodies;
+                let velocity = |h: Option<RigidBodyHandle>, p: Vector| {
+                    h.and_then(|h| bodies.get(h))
+                        .map(|rb| rb.velocity_at_point(p))
+                        .unwrap_or_default()
+                };
+                // A persistent pair is Rapier's (resting or sliding contact).
+                if self.was_closed(super::world::pair_key(context.collider1, context.collider2)) {
+                    return;
+                }
+                let (b1, b2) = (context.rigid_body1, context.rigid_body2);
+                let threshold = self.min_approach_speed;
+                context.solver_contacts.retain(|c| {
+                    let vn = (velocity(b2, c.anchor2) - velocity(b1, c.anchor1)).dot(n);
+                    c.dist <= 0.0 && vn >= -threshold
+                });
             }
             HookMode::Native => *context.restitution = pair.impact.restitution,
         }

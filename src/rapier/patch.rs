@@ -30,7 +30,7 @@ pub struct PatchRule {
 impl Default for PatchRule {
     fn default() -> Self {
         PatchRule {
-            closed_tolerance: 0.0,
+            closed_tolerance: 1e-9,
             lambda: 9,
             min_patch_length: 1e-9,
         }

@@ -68,8 +68,7 @@ pub struct ToppleStats {
 #[derive(Debug)]
 pub struct ToppleRapier {
     hooks: ToppleHooks,
-    /// Settings of the impact pass (may be changed between steps).
-    pub settings: ToppleSettings,
+    settings: ToppleSettings,
     groups: ImpactGroups,
     bodies: Vec<Body>,
     handles: Vec<RigidBodyHandle>,
@@ -77,12 +76,18 @@ pub struct ToppleRapier {
     contacts: Vec<PointContact>,
     manifold: ContactManifold<(), ()>,
     points: Vec<ManifoldPoint>,
+    closed_now: Vec<u64>,
     reports: Vec<ImpactReport>,
     stats: ToppleStats,
-    resolved_initial: bool,
 }
 
 const NO_SLOT: u32 = u32::MAX;
+
+/// A collider pair as one number (arena indices, smaller first).
+pub(crate) fn pair_key(a: ColliderHandle, b: ColliderHandle) -> u64 {
+    let (a, b) = (a.into_raw_parts().0 as u64, b.into_raw_parts().0 as u64);
+    (a.min(b) << 32) | a.max(b)
+}
 
 fn v2(v: Vector) -> [f64; 2] {
     [v.x, v.y]
@@ -104,7 +109,7 @@ impl ToppleRapier {
     fn with_mode(settings: ToppleSettings, mode: HookMode) -> Self {
         ToppleRapier {
             hooks: ToppleHooks::new(mode),
-            settings,
+            settings: ToppleSettings::default(),
             groups: ImpactGroups::default(),
             bodies: Vec::new(),
             handles: Vec::new(),
@@ -112,10 +117,27 @@ impl ToppleRapier {
             contacts: Vec::new(),
             manifold: ContactManifold::new(),
             points: Vec::new(),
+            closed_now: Vec::new(),
             reports: Vec::new(),
             stats: ToppleStats::default(),
-            resolved_initial: false,
         }
+        .with_settings(settings)
+    }
+
+    fn with_settings(mut self, settings: ToppleSettings) -> Self {
+        self.set_settings(settings);
+        self
+    }
+
+    /// The settings of the impact pass.
+    pub fn settings(&self) -> &ToppleSettings {
+        &self.settings
+    }
+
+    /// Changes the settings (between steps).
+    pub fn set_settings(&mut self, settings: ToppleSettings) {
+        self.settings = settings;
+        self.hooks.min_approach_speed = settings.min_approach_speed;
     }
 
     /// Adds a material; returns its id.
@@ -160,15 +182,11 @@ impl ToppleRapier {
         self.stats
     }
 
-    /// One step of a [`PhysicsWorld`]: impacts present before the first step
-    /// are resolved first; then Rapier steps with topple's hooks and the
-    /// impacts at the new positions are resolved. Returns the number of
-    /// impacts resolved after the step.
+    /// One step of a [`PhysicsWorld`]: Rapier steps with topple's hooks (which
+    /// keep Rapier's solver off approaching contacts of managed pairs), then
+    /// the impacts at the new positions are resolved. Returns the number of
+    /// impacts resolved.
     pub fn step(&mut self, world: &mut PhysicsWorld) -> Result<usize, ImpactError> {
-        if !self.resolved_initial {
-            self.resolve_impacts(&mut world.bodies, &world.colliders, &world.narrow_phase)?;
-            self.resolved_initial = true;
-        }
         world.step_with_events(&self.hooks, &());
         self.resolve_impacts(&mut world.bodies, &world.colliders, &world.narrow_phase)
     }
@@ -222,6 +240,7 @@ impl ToppleRapier {
         self.bodies.clear();
         self.handles.clear();
         self.contacts.clear();
+        self.closed_now.clear();
         let rule = self.settings.patch;
         let prediction = rule.closed_tolerance.max(0.0);
         let dispatcher = DefaultQueryDispatcher;
@@ -284,6 +303,9 @@ impl ToppleRapier {
             if b1.is_none() && b2.is_none() {
                 continue;
             }
+            let key = pair_key(pair.collider1, pair.collider2);
+            let persistent = self.hooks.was_closed(key);
+            self.closed_now.push(key);
             let contacts = &mut self.contacts;
             for_each_contact_point(&self.points, &rule, |point, dist| {
                 contacts.push(PointContact {
@@ -292,6 +314,7 @@ impl ToppleRapier {
                     normal,
                     dist,
                     material,
+                    persistent,
                 })
             });
         }
@@ -302,6 +325,19 @@ impl ToppleRapier {
             &self.settings,
             &mut self.reports,
         );
+        // The closed pairs of this pass are the persistent ones of the next.
+        // Pairs of sleeping bodies were not queried: keep them from before.
+        self.hooks
+            .keep_sleeping_closed(&mut self.closed_now, |key| {
+                let c = |i: u32| colliders.get_unknown_gen(i).map(|(c, _)| c);
+                let (a, b) = ((key >> 32) as u32, key as u32);
+                let asleep = |co: Option<&rapier2d_f64::prelude::Collider>| {
+                    co.and_then(|co| co.parent())
+                        .and_then(|h| bodies.get(h))
+                        .is_none_or(|rb| !rb.is_dynamic() || rb.is_sleeping())
+                };
+                asleep(c(a)) && asleep(c(b))
+            });
         // Reset the slot map (only the entries used), then write back.
         for h in &self.handles {
             self.slot[h.into_raw_parts().0 as usize] = NO_SLOT;

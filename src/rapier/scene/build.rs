@@ -78,8 +78,9 @@ fn pair_material(l: &PairLaw) -> PairMaterial {
     )
 }
 
-/// topple's settings from a scene's solver section.
-pub fn topple_settings(s: &SolverSpec) -> ToppleSettings {
+/// topple's settings from a scene's solver section and gravity (m/s²).
+pub fn topple_settings(s: &SolverSpec, gravity: [f64; 2]) -> ToppleSettings {
+    let g = gravity[0].hypot(gravity[1]);
     ToppleSettings {
         impact: match s.tolerance {
             Some(t) => ImpactSettings::adaptive(t),
@@ -90,7 +91,8 @@ pub fn topple_settings(s: &SolverSpec) -> ToppleSettings {
             lambda: s.lambda,
             ..PatchRule::default()
         },
-        min_approach_speed: s.min_approach_speed,
+        min_approach_speed: s.min_approach_speed.unwrap_or((2.0 * g * s.dt).max(1e-3)),
+        max_group_hops: s.max_group_hops,
     }
 }
 
@@ -117,7 +119,7 @@ pub fn build(scene: &Scene, engine: Engine) -> anyhow::Result<SceneWorld> {
         ..PhysicsWorld::default()
     };
     let mut topple = match engine {
-        Engine::Rapier => ToppleRapier::new(topple_settings(s)),
+        Engine::Rapier => ToppleRapier::new(topple_settings(s, scene.gravity)),
         Engine::RapierNative => ToppleRapier::native(),
     };
     let mut ids = HashMap::new();

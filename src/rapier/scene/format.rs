@@ -74,8 +74,12 @@ pub struct SolverSpec {
     pub tolerance: Option<f64>,
     /// λ points across a flat contact patch.
     pub lambda: usize,
-    /// Approach speed (m/s) above which a closed contact starts an impact.
-    pub min_approach_speed: f64,
+    /// Approach speed (m/s) above which a new closed contact starts an
+    /// impact; default max(10⁻³, 2|g|Δt).
+    pub min_approach_speed: Option<f64>,
+    /// Impact window: bodies more than this many closed contacts away from
+    /// the impact act as fixed (none: the whole connected group).
+    pub max_group_hops: Option<usize>,
     /// Gap (m) at or below which a contact point is closed.
     pub closed_tolerance: f64,
 }
@@ -90,8 +94,9 @@ impl Default for SolverSpec {
             impulse_step: 1e-4,
             tolerance: None,
             lambda: 9,
-            min_approach_speed: 1e-3,
-            closed_tolerance: 0.0,
+            min_approach_speed: None,
+            max_group_hops: None,
+            closed_tolerance: 1e-9,
         }
     }
 }
