@@ -830,7 +830,7 @@ impl ImpactSolver {
         out: &mut ImpactOutcome,
     ) -> Result<StopReason, ImpactError> {
         let p0 = self.scales.impulse;
-        let mut h = p0 * tolerance.cbrt().min(1e-1) * 0.1;
+        let mut h = p0 * tolerance.sqrt().min(1e-2);
         let h_min = p0 * 1e-14;
         let mut attempts = 0usize;
         loop {
@@ -864,7 +864,9 @@ impl ImpactSolver {
             // Differences at the level of rounding are no error; the allowed
             // error per step never falls below that level either.
             let error = (self.difference() - ROUNDING).max(0.0);
-            let allowed = tolerance.max(ROUNDING);
+            // Error per unit step: the global error stays near `tolerance`
+            // times the total impulse over P₀.
+            let allowed = (tolerance * taken / p0).max(ROUNDING);
             if error <= allowed || h <= h_min {
                 // Halves that ended the impact are kept as they are.
                 if !finished {
@@ -874,9 +876,9 @@ impl ImpactSolver {
                 if out.steps % 4096 == 0 && !self.finite() {
                     return Err(ImpactError::NonFinite { steps: out.steps });
                 }
-                // local error ∝ h³
+                // local error ∝ h³ against an allowance ∝ h
                 let grow = if error > 0.0 {
-                    0.9 * (allowed / error).cbrt()
+                    0.9 * (allowed / error).sqrt()
                 } else {
                     4.0
                 };
@@ -886,7 +888,7 @@ impl ImpactSolver {
                 self.velocity.copy_from_slice(&self.saved_velocity);
                 self.state.copy_from_slice(&self.saved_state);
                 self.elapsed = elapsed;
-                let shrink = 0.9 * (allowed / error).cbrt();
+                let shrink = 0.9 * (allowed / error).sqrt();
                 h = (taken * shrink.clamp(0.1, 0.9)).max(h_min);
             }
         }
