@@ -5,9 +5,14 @@
 use clap::{Parser, Subcommand};
 
 mod impact;
+mod theory;
 
 #[derive(Parser)]
-#[command(name = "topple", version, about = "LZB multiple impacts for dominoes, Rapier and Bevy")]
+#[command(
+    name = "topple",
+    version,
+    about = "LZB multiple impacts for dominoes, Rapier and Bevy"
+)]
 struct Cli {
     #[command(subcommand)]
     command: Command,
@@ -17,6 +22,8 @@ struct Cli {
 enum Command {
     /// Resolve one multiple impact given as JSON (FILE, or - for stdin).
     Impact(impact::Args),
+    /// Natural speed of the domino wave by the cooperative, extended and single collision models.
+    Theory(theory::Args),
 }
 
 /// Parses the command line, runs the subcommand, returns the exit status.
@@ -24,6 +31,7 @@ pub fn run() -> i32 {
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Impact(args) => impact::run(args),
+        Command::Theory(args) => theory::run(args),
     };
     match result {
         Ok(()) => 0,
