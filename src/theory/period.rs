@@ -44,7 +44,7 @@ pub(crate) fn peak_integral(
         0.0
     };
     let tolerance = TOLERANCE.max(10.0 * noise / um);
-    if !(tolerance <= LOOSEST) {
+    if tolerance.is_nan() || tolerance > LOOSEST {
         return Err(TheoryError::NotConverged(format!(
             "too close to a stall to resolve the period to {LOOSEST:e} \
              (minimum of u {um:e}, rounding error {noise:e})"

@@ -144,3 +144,34 @@ pub(crate) fn solve_single(geom: &Geometry, mu: f64, e: f64) -> Result<Outcome, 
         nodes: 0,
     }))
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Kinetic energy (∝ ω_A² + ω_B², equal inertias) never grows in a collision,
+    /// and with μ = 0 the struck block gets (1 + e)/2 of the striker's velocity
+    /// (equal lever arms h cos θ_c about both pivots).
+    #[test]
+    fn collision_dissipates_and_frictionless_limit() {
+        for &d in &[0.05, 0.12, 0.3] {
+            for i in 1..20 {
+                let s = 0.05 * i as f64;
+                let geom = Geometry::new(d, s).unwrap();
+                let tc = geom.collision_angle().unwrap();
+                for &mu in &[0.0, 0.1, 0.3, 0.6] {
+                    for &e in &[0.0, 0.5, 1.0] {
+                        if let Some((wa, wb)) = collision_ratio(&geom, tc, mu, e) {
+                            assert!(wa * wa + wb * wb <= 1.0 + 1e-12, "{d} {s} {mu} {e}");
+                        }
+                    }
+                }
+                for &e in &[0.0, 0.62, 1.0] {
+                    let (wa, wb) = collision_ratio(&geom, tc, 0.0, e).unwrap();
+                    assert!((wb - 0.5 * (1.0 + e)).abs() < 1e-14);
+                    assert!((wa - 0.5 * (1.0 - e)).abs() < 1e-14);
+                }
+            }
+        }
+    }
+}
