@@ -64,14 +64,14 @@ fn draw(
     chart
         .configure_mesh()
         .x_desc("s/h")
-        .y_desc("v / sqrt(g h)")
+        .y_desc("v / √(gh)")
         .draw()?;
 
     for (i, model) in models.iter().enumerate() {
         let label = match *model {
-            Model::Cooperative => "cooperative group (mu = 0)".to_string(),
-            Model::Extended { mu } => format!("extended group (mu = {mu})"),
-            Model::Single { mu, e } => format!("single collision (mu = {mu}, e = {e})"),
+            Model::Cooperative => "cooperative group (μ = 0)".to_string(),
+            Model::Extended { mu } => format!("extended group (μ = {mu})"),
+            Model::Single { mu, e } => format!("single collision (μ = {mu}, e = {e})"),
         };
         let color = match model {
             Model::Cooperative => BLACK,
