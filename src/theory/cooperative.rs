@@ -63,6 +63,15 @@ pub(crate) fn solve_group(geom: &Geometry, mu: f64) -> Result<Outcome, TheoryErr
     if alpha_c <= 0.0 {
         return Ok(Outcome::NoWave(NoWave::FrictionBlocksImpact));
     }
+    // Far down the train Δ_k → 0 and ρ_{k+1}/ρ_k → 1 − λ sin θ_∞ − μ d; the
+    // weighted sums exist only if that ratio is below 1 in size.
+    let far_ratio = 1.0 - geom.pitch() * theta_inf.sin() - mu * d;
+    if far_ratio.abs() >= 0.999 {
+        return Err(TheoryError::OutsideModel(format!(
+            "the friction weights of the leaning train do not decay (rho_(k+1)/rho_k -> {far_ratio:.4} \
+             at the rest angle): the group model needs |1 - (lambda/h) sin theta_inf - mu d/h| < 1"
+        )));
+    }
     let inertia = geom.pivot_inertia();
 
     // Samples (a_j, b_j) at the Chebyshev–Lobatto points of degree n.
@@ -70,9 +79,9 @@ pub(crate) fn solve_group(geom: &Geometry, mu: f64) -> Result<Outcome, TheoryErr
         let s = train_sums(geom, mu, theta)?;
         *blocks = (*blocks).max(s.blocks);
         if s.rho_c <= 0.0 {
-            return Err(TheoryError::NotConverged(format!(
-                "the weighted train inertia sum rho_k c_k = {} is not positive at theta_0 = {theta}: \
-                 friction mu = {mu} is outside the group model",
+            return Err(TheoryError::OutsideModel(format!(
+                "the weighted train inertia sum rho_k c_k = {} is not positive at theta_0 = {theta} \
+                 with friction mu = {mu}",
                 s.rho_c
             )));
         }

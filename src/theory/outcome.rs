@@ -91,6 +91,14 @@ impl std::fmt::Display for NoWave {
 }
 
 /// Result of a model at one geometry.
+///
+/// ```
+/// use topple::theory::{solve, Geometry, Model, Outcome};
+/// match solve(&Model::Cooperative, &Geometry::new(0.12, 0.5).unwrap()).unwrap() {
+///     Outcome::Wave(w) => assert!(w.natural_speed > 1.0),
+///     Outcome::NoWave(reason) => panic!("no wave: {reason}"),
+/// }
+/// ```
 #[derive(Clone, Debug, PartialEq)]
 pub enum Outcome {
     /// A steady wave exists.
@@ -115,14 +123,30 @@ impl Outcome {
 }
 
 /// Errors of the theory layer.
+///
+/// ```
+/// use topple::theory::{solve, Geometry, Model, TheoryError};
+/// let err = solve(&Model::Single { mu: 0.1, e: 1.5 }, &Geometry::new(0.12, 0.3).unwrap());
+/// assert!(matches!(err, Err(TheoryError::InvalidParameter(_))));
+/// // very thick blocks with much friction: the train's friction weights do not decay
+/// let err = solve(&Model::Extended { mu: 0.5 }, &Geometry::new(0.95, 0.847).unwrap());
+/// assert!(matches!(err, Err(TheoryError::OutsideModel(_))));
+/// ```
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
 pub enum TheoryError {
     /// An argument is out of its range (the message says which and why).
     #[error("{0}")]
     InvalidParameter(String),
+    /// The parameters are valid but the model's assumptions break down there
+    /// (the message says how), so it gives no answer.
+    #[error("outside the model: {0}")]
+    OutsideModel(String),
     /// A numerical procedure did not reach its tolerance.
     #[error("not converged: {0}")]
     NotConverged(String),
+    /// [`min_spacing`](super::min_spacing) found no step from "no wave" to "wave".
+    #[error("{0}")]
+    NoThreshold(String),
     /// Writing a table or a plot failed.
     #[error("{0}")]
     Output(String),

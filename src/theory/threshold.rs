@@ -44,7 +44,7 @@ pub fn min_spacing(
     };
     let step = 1e-3;
     if has_wave(step)? {
-        return Err(TheoryError::NotConverged(format!(
+        return Err(TheoryError::NoThreshold(format!(
             "the {} model has a wave already at s/h = {step}",
             model.name()
         )));
@@ -70,7 +70,7 @@ pub fn min_spacing(
         }
         lo = s;
     }
-    Err(TheoryError::NotConverged(format!(
+    Err(TheoryError::NoThreshold(format!(
         "the {} model has no wave for s/h in (0, 1)",
         model.name()
     )))
