@@ -37,7 +37,12 @@ fn json_has_natural_speed() {
     .unwrap()
     .natural_speed()
     .unwrap();
-    assert_eq!(v["natural_speed"].as_f64().unwrap(), lib);
+    // JSON text round trip of an f64 may be off by one unit in the last place
+    let json_speed = v["natural_speed"].as_f64().unwrap();
+    assert!(
+        (json_speed - lib).abs() <= 4.0 * f64::EPSILON * lib,
+        "{json_speed} vs {lib}"
+    );
     assert_eq!(v["wave"], serde_json::Value::Bool(true));
 
     let out = topple(&[

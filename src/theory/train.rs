@@ -57,12 +57,18 @@ pub(crate) struct TrainSums {
 pub(crate) fn train_sums(geom: &Geometry, mu: f64, theta0: f64) -> Result<TrainSums, TheoryError> {
     let lambda = geom.pitch();
     let d = geom.thickness_ratio();
-    let (mut theta, mut c, mut dc, mut rho) = (theta0, 1.0_f64, 0.0_f64, 1.0_f64);
+    // sin θ_k and cos θ_k are carried by the angle-addition formulas
+    // (sin Δ_k = x_k, cos Δ_k = √(1 − x_k²)): no trigonometric call per block.
+    let (mut sin_t, mut cos_t) = theta0.sin_cos();
+    let (sin_phi, cos_phi) = geom.tip_angle().sin_cos();
+    let arm = geom.pivot_to_centre();
+    let (mut c, mut dc, mut rho) = (1.0_f64, 0.0_f64, 1.0_f64);
     let mut sums = TrainSums::default();
     let (mut abs_c, mut abs_tau, mut abs_dc) = (0.0_f64, 0.0_f64, 0.0_f64);
     let mut small_in_a_row = 0;
     for k in 0..MAX_TRAIN {
-        let tau = geom.gravity_torque(theta);
+        // gravity torque R sin(θ_k − φ)
+        let tau = arm * (sin_t * cos_phi - cos_t * sin_phi);
         let (tc, tt, td) = (rho * c, rho * tau, rho * dc);
         sums.rho_c += tc;
         sums.rho_tau += tt;
@@ -79,7 +85,6 @@ pub(crate) fn train_sums(geom: &Geometry, mu: f64, theta0: f64) -> Result<TrainS
             return Ok(sums);
         }
         // Next block: leaning-pair relation and the recursions of the module doc.
-        let (sin_t, cos_t) = theta.sin_cos();
         let x = lambda * cos_t - d; // sin Δ_k
         let cos_delta = (1.0 - x * x).sqrt();
         let g = 1.0 - lambda * sin_t / cos_delta;
@@ -91,7 +96,7 @@ pub(crate) fn train_sums(geom: &Geometry, mu: f64, theta0: f64) -> Result<TrainS
         dc = dg * c + g * dc;
         c = c_next;
         rho *= alpha / beta;
-        theta += x.asin();
+        (sin_t, cos_t) = (sin_t * cos_delta + cos_t * x, cos_t * cos_delta - sin_t * x);
     }
     Err(TheoryError::NotConverged(format!(
         "the leaning train did not converge within {MAX_TRAIN} blocks"
