@@ -29,7 +29,7 @@
 //!   50–300 blocks);
 //! - a(θ), b(θ) are sampled at n + 1 Chebyshev–Lobatto points on [0, θ_c] and
 //!   Φ, Ψ are the exact integrals of their interpolants (spectral accuracy);
-//!   n doubles from 16 (reusing the samples) until two successive natural speeds
+//!   n doubles from 8 (reusing the samples) until two successive natural speeds
 //!   agree to `SPEED_TOLERANCE` = 10⁻¹⁰ relative, at most n = 512;
 //! - T is a Clenshaw–Curtis integral of 1/√u, split at the minimum of u and
 //!   stretched there by a sinh map (see `period.rs`), doubled until converged
@@ -38,7 +38,7 @@
 
 use super::chebyshev::{self, Series};
 use super::outcome::{NoWave, Outcome, TheoryError, Wave};
-use super::period::{first_zero, minimum, peak_integral};
+use super::period::{first_zero, golden_min, peak_integral};
 use super::train::train_sums;
 use super::Geometry;
 
@@ -93,7 +93,7 @@ pub(crate) fn solve_group(geom: &Geometry, mu: f64) -> Result<Outcome, TheoryErr
     };
 
     let mut blocks = 0;
-    let mut n = 16;
+    let mut n = 8;
     let mut samples = Vec::with_capacity(n + 1);
     for t in chebyshev::points(0.0, theta_c, n) {
         samples.push(sample(t, &mut blocks)?);
@@ -172,8 +172,23 @@ fn cycle(
     }
     let u0 = q * psi_c / (1.0 - q);
 
-    // Minimum of u0 + Ψ on [0, θ_c]: dense scan of the interpolant, then golden section.
-    let (theta_min, psi_min) = minimum(|t| psi.eval(t), 0.0, theta_c, 8 * n);
+    // Minimum of u0 + Ψ on [0, θ_c]: at an end, or where Ψ' = a e^Φ (known at
+    // the points, which run down from θ_c) turns from negative to positive;
+    // each such interval is searched by golden section.
+    let (mut theta_min, mut psi_min) = if psi_c < 0.0 {
+        (theta_c, psi_c)
+    } else {
+        (0.0, 0.0)
+    };
+    for j in 0..n {
+        let (lo, hi) = (thetas[j + 1], thetas[j]);
+        if a_e_phi[j + 1] <= 0.0 && a_e_phi[j] >= 0.0 {
+            let (t, v) = golden_min(|t| psi.eval(t), lo, hi);
+            if v < psi_min {
+                (theta_min, psi_min) = (t, v);
+            }
+        }
+    }
     if u0 + psi_min <= 0.0 {
         let angle = first_zero(|t| u0 + psi.eval(t), 0.0, theta_min, 8 * n);
         return Ok(Outcome::NoWave(NoWave::LeaderStalls { angle }));

@@ -22,7 +22,7 @@
 //!
 //! Accuracy (target 10⁻⁶ relative): group models: train summed until a block
 //! adds less than 10⁻¹⁴ of the sums; the equation of motion sampled at n + 1
-//! Chebyshev points in the leader angle, n doubled from 16 until two natural
+//! Chebyshev points in the leader angle, n doubled from 8 until two natural
 //! speeds agree to 10⁻¹⁰; the fixed point of the affine cycle map of θ̇_0² in
 //! closed form (no iteration); the period by Clenshaw–Curtis to 10⁻¹²,
 //! stretched around the minimum of θ̇_0² (within ~10⁻⁸ in s/h of a stall the

@@ -82,20 +82,11 @@ pub(crate) fn peak_integral(
     Ok(side(b - t_min, 1.0)? + side(t_min - a, -1.0)?)
 }
 
-/// Location and value of the minimum of `f` on [a, b]: scan of `m` intervals,
-/// then golden-section search in the best bracket to 10⁻¹³ of the interval.
-pub(crate) fn minimum(f: impl Fn(f64) -> f64, a: f64, b: f64, m: usize) -> (f64, f64) {
-    let h = (b - a) / m as f64;
-    let (mut best_i, mut best) = (0, f(a));
-    for i in 1..=m {
-        let v = f(a + h * i as f64);
-        if v < best {
-            best = v;
-            best_i = i;
-        }
-    }
-    let mut lo = a + h * best_i.saturating_sub(1) as f64;
-    let mut hi = (a + h * (best_i + 1) as f64).min(b);
+/// Location and value of the minimum of `f` on [lo, hi] (one minimum there):
+/// golden-section search to 10⁻¹³ of the interval, compared with both ends.
+pub(crate) fn golden_min(f: impl Fn(f64) -> f64, lo: f64, hi: f64) -> (f64, f64) {
+    let (a, b) = (lo, hi);
+    let (mut lo, mut hi) = (lo, hi);
     let ratio = 0.5 * (5.0_f64.sqrt() - 1.0);
     let mut x1 = hi - ratio * (hi - lo);
     let mut x2 = lo + ratio * (hi - lo);
@@ -115,12 +106,16 @@ pub(crate) fn minimum(f: impl Fn(f64) -> f64, a: f64, b: f64, m: usize) -> (f64,
             f2 = f(x2);
         }
     }
-    let (x, v) = if f1 < f2 { (x1, f1) } else { (x2, f2) };
-    if v < best {
-        (x, v)
-    } else {
-        (a + h * best_i as f64, best)
-    }
+    [
+        (a, f(a)),
+        (b, f(b)),
+        if f1 < f2 { (x1, f1) } else { (x2, f2) },
+    ]
+    .into_iter()
+    .fold(
+        (a, f64::INFINITY),
+        |best, c| if c.1 < best.1 { c } else { best },
+    )
 }
 
 /// First point of [a, b] where `f` (positive at a) reaches 0: scan of `m`
