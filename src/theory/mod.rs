@@ -28,8 +28,8 @@
 //! stretched around the minimum of θ̇_0² (within ~10⁻⁸ in s/h of a stall the
 //! rounding of θ̇_0² limits this to 10⁻⁶, and closer still `solve` reports
 //! `NotConverged`). Single collision model: everything closed form but the
-//! period. Cost per point (one thread): ~0.15–0.2 ms for the group models,
-//! ~10 µs for the single collision model.
+//! period. Cost per point (one thread): ~40 µs for the group models, ~2 µs
+//! for the single collision model.
 //!
 //! # Single collision model
 //! The striker A turns about its front bottom edge at θ_c (sin θ_c = s/h); its
