@@ -5,6 +5,7 @@
 use clap::{Parser, Subcommand};
 
 mod impact;
+mod theory;
 
 #[derive(Parser)]
 #[command(
@@ -21,6 +22,8 @@ struct Cli {
 enum Command {
     /// Resolve one multiple impact given as JSON (FILE, or - for stdin).
     Impact(impact::Args),
+    /// Natural speed of the domino wave by the cooperative, extended and single collision models.
+    Theory(theory::Args),
 }
 
 /// Parses the command line, runs the subcommand, returns the exit status.
@@ -28,6 +31,7 @@ pub fn run() -> i32 {
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Impact(args) => impact::run(args),
+        Command::Theory(args) => theory::run(args),
     };
     match result {
         Ok(()) => 0,
