@@ -129,3 +129,45 @@ fn adaptive_matches_hertz_chain_to_1e_4() {
     let err = worst_error(&ImpactSettings::adaptive(1e-6));
     assert!(err < 1e-4, "worst velocity error {err:.3e}");
 }
+
+#[test]
+#[ignore]
+fn explore_work_precision() {
+    let cases: Vec<_> = chains()
+        .into_iter()
+        .map(|(n, c)| {
+            let e = c.integrate(c.time_step(4000.0));
+            (n, c, e)
+        })
+        .collect();
+    let run = |label: String, settings: ImpactSettings| {
+        let mut solver = ImpactSolver::new();
+        let mut worst: f64 = 0.0;
+        let mut total = std::time::Duration::ZERO;
+        let mut per = vec![];
+        for (_, chain, expected) in &cases {
+            let (bodies, contacts) = resolver_input(chain);
+            let t = std::time::Instant::now();
+            let out = solver.solve(&bodies, &contacts, &settings).unwrap();
+            total += t.elapsed();
+            let err = out
+                .bodies
+                .iter()
+                .zip(expected)
+                .map(|(b, e)| (b.velocity[0] - e).abs())
+                .fold(0.0, f64::max);
+            per.push(format!("{err:.0e}/{}", out.steps));
+            worst = worst.max(err);
+        }
+        eprintln!(
+            "{label}: worst {worst:.2e} in {total:?} :: {}",
+            per.join(" ")
+        );
+    };
+    for tol in [1e-4, 1e-5, 1e-6, 1e-7, 1e-8] {
+        run(format!("ADAPT {tol:e}"), ImpactSettings::adaptive(tol));
+    }
+    for dp in [1e-3, 1e-4] {
+        run(format!("FIXED {dp:e}"), ImpactSettings::fixed(dp));
+    }
+}

@@ -6,6 +6,7 @@ use clap::{Parser, Subcommand};
 
 mod impact;
 mod scene;
+mod theory;
 
 #[derive(Parser)]
 #[command(
@@ -24,6 +25,8 @@ enum Command {
     Impact(impact::Args),
     /// Run a TOML scene in Rapier, with topple's impacts or natively.
     Scene(scene::Args),
+    /// Natural speed of the domino wave by the cooperative, extended and single collision models.
+    Theory(theory::Args),
 }
 
 /// Parses the command line, runs the subcommand, returns the exit status.
@@ -32,6 +35,7 @@ pub fn run() -> i32 {
     let result = match cli.command {
         Command::Impact(args) => impact::run(args),
         Command::Scene(args) => scene::run(args),
+        Command::Theory(args) => theory::run(args),
     };
     match result {
         Ok(()) => 0,

@@ -104,8 +104,13 @@ struct Scales {
 /// Landing fractions at or below this are not worth a step of their own.
 const MIN_LANDING: f64 = 1e-9;
 
+/// Friction sweeps per step at most, and the slip correction (relative to
+/// the velocity scale) below which they stop.
+const FRICTION_SWEEPS: usize = 16;
+const FRICTION_SETTLED: f64 = 1e-13;
+
 /// Relative differences below this are rounding, not truncation error.
-const ROUNDING: f64 = 1e-13;
+const ROUNDING: f64 = 1e-11;
 
 /// Result of one step attempt.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -167,6 +172,9 @@ pub struct ImpactSolver {
     mid_velocity: Vec<[f64; 3]>,
     mid_state: Vec<ContactState>,
     mid_energy: Vec<f64>,
+    /// Tangential increments of the step and stick state at its start.
+    tangent_step: Vec<f64>,
+    stuck_at_start: Vec<bool>,
     /// Contacts whose last bit of energy is released without a step.
     released: Vec<bool>,
     scales: Scales,
@@ -346,6 +354,9 @@ impl ImpactSolver {
         self.mid_velocity.resize(nb, [0.0; 3]);
         self.mid_state.resize(n, ContactState::default());
         self.mid_energy.resize(n, 0.0);
+        self.tangent_step.resize(n, 0.0);
+        self.stuck_at_start.clear();
+        self.stuck_at_start.resize(n, false);
         self.released.clear();
         self.released.resize(n, false);
         self.state.clear();
@@ -500,8 +511,10 @@ impl ImpactSolver {
             let rate = Self::normal_rate(row, &self.velocity);
             self.rate[i] = rate;
             let s = &mut self.state[i];
-            // e = 0: the energy is lost as soon as expansion starts.
-            if s.energy > 0.0 && rate >= -threshold && row.restitution == 0.0 {
+            // e = 0: the energy is lost as soon as expansion starts. Rates
+            // within the rounding band count as neither compression nor
+            // expansion, so a contact held closed keeps its force.
+            if s.energy > 0.0 && rate > threshold && row.restitution == 0.0 {
                 s.energy = 0.0;
             }
             if s.energy > largest_energy {
@@ -604,6 +617,14 @@ impl ImpactSolver {
                 let at = if inc > 0.0 && rate < -threshold && rate + change > 0.0 {
                     // compression ends
                     -rate / change
+                } else if inc > 0.0 && row.restitution == 0.0 && s.energy > 0.0 {
+                    // e = 0 at the end of compression: if this step would
+                    // open it, its energy goes without impulse (errata §2)
+                    if rate + change > threshold {
+                        released_now = true;
+                        self.released[i] = true;
+                    }
+                    1.0
                 } else if inc > 0.0 && rate >= -threshold && s.energy > 0.0 {
                     // expansion: release(σ) = σ inc (rate + σ change / 2) / e² reaches E
                     let e2 = row.restitution * row.restitution;
@@ -693,36 +714,69 @@ impl ImpactSolver {
             *inc *= factor;
         }
 
-        // 5. Coulomb friction, one Gauss–Seidel pass.
+        // 5. Coulomb friction: projected Gauss–Seidel sweeps over this step's
+        // tangential increments until the slip corrections are rounding.
+        // A contact sticking at the start of the step stays stuck while that
+        // needs |dP_t| ≤ μ_s dP_n, a sliding one sticks when |dP_t| ≤ μ dP_n
+        // stops its slip; otherwise |dP_t| = μ dP_n against the slip.
+        let mut frictional = false;
         for i in 0..n {
-            let inc = self.increment[i];
+            self.tangent_step[i] = 0.0;
             let row = &self.rows[i];
-            if inc <= 0.0 || row.w_tt <= 0.0 || (row.friction == 0.0 && row.stick_friction == 0.0) {
-                continue;
+            self.stuck_at_start[i] = self.state[i].sticking;
+            frictional |= self.increment[i] > 0.0
+                && row.w_tt > 0.0
+                && (row.friction > 0.0 || row.stick_friction > 0.0);
+        }
+        if frictional {
+            let settled = FRICTION_SETTLED * self.scales.velocity;
+            for _sweep in 0..FRICTION_SWEEPS {
+                let mut largest_change: f64 = 0.0;
+                for i in 0..n {
+                    let inc = self.increment[i];
+                    let row = &self.rows[i];
+                    if inc <= 0.0
+                        || row.w_tt <= 0.0
+                        || (row.friction == 0.0 && row.stick_friction == 0.0)
+                    {
+                        continue;
+                    }
+                    let slip = Self::tangent_rate(row, &self.velocity);
+                    let wanted = self.tangent_step[i] - slip / row.w_tt;
+                    let stick_limit = if self.stuck_at_start[i] {
+                        row.stick_friction.max(row.friction)
+                    } else {
+                        row.friction
+                    } * inc;
+                    let (value, sticking) = if wanted.abs() <= stick_limit {
+                        (wanted, true)
+                    } else {
+                        (wanted.signum() * row.friction * inc, false)
+                    };
+                    self.state[i].sticking = sticking;
+                    let change = value - self.tangent_step[i];
+                    if change != 0.0 {
+                        self.tangent_step[i] = value;
+                        Self::apply(
+                            row,
+                            row.tangent,
+                            row.a_rt,
+                            row.b_rt,
+                            change,
+                            &self.inv_mass,
+                            &self.inv_inertia,
+                            &mut self.velocity,
+                        );
+                        largest_change = largest_change.max(change.abs() * row.w_tt);
+                    }
+                }
+                if largest_change <= settled {
+                    break;
+                }
             }
-            let slip = Self::tangent_rate(row, &self.velocity);
-            let needed = -slip / row.w_tt;
-            let s = &mut self.state[i];
-            let dpt = if s.sticking && needed.abs() <= row.stick_friction * inc {
-                needed
-            } else if needed.abs() <= row.friction * inc {
-                s.sticking = true;
-                needed
-            } else {
-                s.sticking = false;
-                needed.signum() * row.friction * inc
-            };
-            s.tangent_impulse += dpt;
-            Self::apply(
-                row,
-                row.tangent,
-                row.a_rt,
-                row.b_rt,
-                dpt,
-                &self.inv_mass,
-                &self.inv_inertia,
-                &mut self.velocity,
-            );
+            for i in 0..n {
+                self.state[i].tangent_impulse += self.tangent_step[i];
+            }
         }
 
         // 6. energies with the mid-step rate (the end rates go to `rate_change`).
@@ -740,7 +794,8 @@ impl ImpactSolver {
                 let mid = 0.5 * (self.rate[i] + end);
                 let s = &mut self.state[i];
                 s.normal_impulse += inc;
-                if mid < 0.0 {
+                if mid <= threshold {
+                    // compression (or the neutral rounding band)
                     s.energy -= mid * inc;
                 } else if row.restitution > 0.0 {
                     s.energy -= mid * inc / (row.restitution * row.restitution);
@@ -830,7 +885,7 @@ impl ImpactSolver {
         out: &mut ImpactOutcome,
     ) -> Result<StopReason, ImpactError> {
         let p0 = self.scales.impulse;
-        let mut h = p0 * tolerance.cbrt().min(1e-1) * 0.1;
+        let mut h = p0 * tolerance.sqrt().min(1e-2);
         let h_min = p0 * 1e-14;
         let mut attempts = 0usize;
         loop {
@@ -864,7 +919,9 @@ impl ImpactSolver {
             // Differences at the level of rounding are no error; the allowed
             // error per step never falls below that level either.
             let error = (self.difference() - ROUNDING).max(0.0);
-            let allowed = tolerance.max(ROUNDING);
+            // Error per unit step: the global error stays near `tolerance`
+            // times the total impulse over P₀.
+            let allowed = (tolerance * taken / p0).max(ROUNDING);
             if error <= allowed || h <= h_min {
                 // Halves that ended the impact are kept as they are.
                 if !finished {
@@ -874,9 +931,9 @@ impl ImpactSolver {
                 if out.steps % 4096 == 0 && !self.finite() {
                     return Err(ImpactError::NonFinite { steps: out.steps });
                 }
-                // local error ∝ h³
+                // local error ∝ h³ against an allowance ∝ h
                 let grow = if error > 0.0 {
-                    0.9 * (allowed / error).cbrt()
+                    0.9 * (allowed / error).sqrt()
                 } else {
                     4.0
                 };
@@ -886,7 +943,7 @@ impl ImpactSolver {
                 self.velocity.copy_from_slice(&self.saved_velocity);
                 self.state.copy_from_slice(&self.saved_state);
                 self.elapsed = elapsed;
-                let shrink = 0.9 * (allowed / error).cbrt();
+                let shrink = 0.9 * (allowed / error).sqrt();
                 h = (taken * shrink.clamp(0.1, 0.9)).max(h_min);
             }
         }

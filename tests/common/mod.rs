@@ -1,1 +1,4 @@
+#![allow(dead_code)]
+pub mod compliant;
 pub mod hertz;
+pub mod leaning;
