@@ -56,9 +56,9 @@ pub struct ToppleSettings {
     /// one step.
     pub min_approach_speed: f64,
     /// The window of an impact: only free bodies within this many closed
-    /// contacts of the bodies that started it take part; the others act as
-    /// the fixed world (like the paper's active window κ). `None`: the whole
-    /// connected group.
+    /// contacts of the bodies that started it take part, and contacts with
+    /// bodies beyond are left out (like the paper's active window κ). `None`:
+    /// the whole connected group.
     pub max_group_hops: Option<usize>,
 }
 
@@ -255,6 +255,13 @@ impl ImpactGroups {
         }
         let inside = &self.inside;
         let free = |i: Option<usize>, bodies: &[Body]| i.filter(|&i| !bodies[i].fixed && inside[i]);
+        // A contact reaching a free body outside the window is left out (not
+        // made a wall: a wall there could wedge the window shut).
+        let crosses = |c: &PointContact, bodies: &[Body]| {
+            c.bodies
+                .iter()
+                .any(|&i| i.is_some_and(|i| !bodies[i].fixed && !inside[i]))
+        };
 
         // Connected components of free bodies through closed contacts.
         self.parent.clear();
@@ -302,7 +309,10 @@ impl ImpactGroups {
                 }
             }
         }
-        for c in contacts.iter().filter(|c| c.dist <= tol) {
+        for c in contacts
+            .iter()
+            .filter(|c| c.dist <= tol && !crosses(c, bodies))
+        {
             if let Some(r) = root_of(&mut self.parent, c, bodies) {
                 let g = self.group_of_root[r];
                 if g != NONE {
@@ -332,7 +342,11 @@ impl ImpactGroups {
                     }
                 }
             }
-            for (k, c) in contacts.iter().enumerate().filter(|(_, c)| c.dist <= tol) {
+            for (k, c) in contacts
+                .iter()
+                .enumerate()
+                .filter(|(_, c)| c.dist <= tol && !crosses(c, bodies))
+            {
                 if let Some(r) = root_of(&mut self.parent, c, bodies) {
                     let g = self.group_of_root[r];
                     if g != NONE {

@@ -78,7 +78,7 @@ pub struct SolverSpec {
     /// impact; default max(10⁻³, 2|g|Δt).
     pub min_approach_speed: Option<f64>,
     /// Impact window: bodies more than this many closed contacts away from
-    /// the impact act as fixed (none: the whole connected group).
+    /// the impact and their contacts are left out (none: the whole group).
     pub max_group_hops: Option<usize>,
     /// Gap (m) at or below which a contact point is closed.
     pub closed_tolerance: f64,
