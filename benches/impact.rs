@@ -127,7 +127,10 @@ fn settings() -> Vec<(String, ImpactSettings)> {
         list.push((format!("fixed ΔP={step:e}·P₀"), ImpactSettings::fixed(step)));
     }
     for tol in [1e-4, 1e-6, 1e-8] {
-        list.push((format!("adaptive tol={tol:e}"), ImpactSettings::adaptive(tol)));
+        list.push((
+            format!("adaptive tol={tol:e}"),
+            ImpactSettings::adaptive(tol),
+        ));
     }
     list
 }
@@ -158,7 +161,10 @@ fn bench(c: &mut Criterion) {
             let start = Instant::now();
             let (err, steps) = error(case, &mut solver, &s);
             let time = start.elapsed();
-            println!("| {} | {label} | {steps} | {err:.1e} | {time:.1?} |", case.name);
+            println!(
+                "| {} | {label} | {steps} | {err:.1e} | {time:.1?} |",
+                case.name
+            );
         }
     }
     for case in &cases {

@@ -63,7 +63,33 @@ struct Row {
     movable: bool,
 }
 
+/// A direction of impulse with its moment arms r×dir on the two bodies.
+#[derive(Clone, Copy, Debug)]
+struct Axis {
+    dir: [f64; 2],
+    arm_a: f64,
+    arm_b: f64,
+}
+
 impl Row {
+    #[inline]
+    fn normal_axis(&self) -> Axis {
+        Axis {
+            dir: self.normal,
+            arm_a: self.a_rn,
+            arm_b: self.b_rn,
+        }
+    }
+
+    #[inline]
+    fn tangent_axis(&self) -> Axis {
+        Axis {
+            dir: self.tangent,
+            arm_a: self.a_rt,
+            arm_b: self.b_rt,
+        }
+    }
+
     #[inline]
     fn force(&self, stored_energy: f64) -> f64 {
         if stored_energy <= 0.0 {
@@ -419,18 +445,17 @@ impl ImpactSolver {
             - va[2] * row.a_rt
     }
 
-    /// Applies impulse `p` along `dir` (arms `rn_a`, `rn_b`) to the row's bodies.
+    /// Applies impulse `p` along `axis` to the row's bodies.
     #[inline]
     fn apply(
         row: &Row,
-        dir: [f64; 2],
-        arm_a: f64,
-        arm_b: f64,
+        axis: Axis,
         p: f64,
         inv_mass: &[f64],
         inv_inertia: &[f64],
         v: &mut [[f64; 3]],
     ) {
+        let Axis { dir, arm_a, arm_b } = axis;
         let (ma, ia) = (inv_mass[row.a] * p, inv_inertia[row.a] * p);
         let va = &mut v[row.a];
         va[0] -= ma * dir[0];
@@ -594,9 +619,7 @@ impl ImpactSolver {
                     let row = &self.rows[i];
                     Self::apply(
                         row,
-                        row.normal,
-                        row.a_rn,
-                        row.b_rn,
+                        row.normal_axis(),
                         inc,
                         &self.inv_mass,
                         &self.inv_inertia,
@@ -678,9 +701,7 @@ impl ImpactSolver {
                         let row = &self.rows[i];
                         Self::apply(
                             row,
-                            row.normal,
-                            row.a_rn,
-                            row.b_rn,
+                            row.normal_axis(),
                             -self.increment[i] * scale * length,
                             &self.inv_mass,
                             &self.inv_inertia,
@@ -698,9 +719,7 @@ impl ImpactSolver {
                     let row = &self.rows[i];
                     Self::apply(
                         row,
-                        row.normal,
-                        row.a_rn,
-                        row.b_rn,
+                        row.normal_axis(),
                         inc,
                         &self.inv_mass,
                         &self.inv_inertia,
@@ -759,9 +778,7 @@ impl ImpactSolver {
                         self.tangent_step[i] = value;
                         Self::apply(
                             row,
-                            row.tangent,
-                            row.a_rt,
-                            row.b_rt,
+                            row.tangent_axis(),
                             change,
                             &self.inv_mass,
                             &self.inv_inertia,
@@ -836,7 +853,7 @@ impl ImpactSolver {
             if self.rows[i].movable && self.increment[i] == 0.0 && s.energy == 0.0 && dt.is_finite()
             {
                 let mid = 0.5 * (self.rate[i] + self.rate_change[i]);
-                s.gap = s.gap + mid * dt;
+                s.gap += mid * dt;
                 // closed when what is left is rounding of the landing
                 if s.gap <= 1e-9 * (mid.abs() * dt) {
                     s.gap = 0.0;
