@@ -25,7 +25,12 @@ fn elastic_leaning_group_matches_the_compliant_model() {
     let (bodies, contacts) = elastic_group().build();
     let expected = compliant::integrate(&bodies, &contacts, 400.0);
     let speed = 5.0 * 0.08; // tip speed of the pushed block (m/s)
-    for settings in [ImpactSettings::default(), ImpactSettings::adaptive(1e-6)] {
+                            // Energy: the fixed step books it exactly (to rounding); the adaptive
+                            // step's energy error is its tolerance times its number of steps.
+    for (settings, energy_tolerance) in [
+        (ImpactSettings::default(), 1e-6),
+        (ImpactSettings::adaptive(1e-8), 1e-4),
+    ] {
         let out = ImpactSolver::new()
             .solve(&bodies, &contacts, &settings)
             .unwrap();
@@ -67,8 +72,10 @@ fn domino_group_dissipates_and_both_step_controls_agree() {
     let fine = ImpactSolver::new()
         .solve(&bodies, &contacts, &ImpactSettings::fixed(1e-5))
         .unwrap();
+    // Event-heavy (e = 0 and stick/slip): the adaptive mode needs a tight
+    // tolerance here (README, work against precision).
     let adaptive = ImpactSolver::new()
-        .solve(&bodies, &contacts, &ImpactSettings::adaptive(1e-6))
+        .solve(&bodies, &contacts, &ImpactSettings::adaptive(1e-8))
         .unwrap();
     assert!(fixed.kinetic_energy_after < fixed.kinetic_energy_before);
     for out in [&fixed, &adaptive] {
