@@ -25,7 +25,12 @@ fn elastic_leaning_group_matches_the_compliant_model() {
     let (bodies, contacts) = elastic_group().build();
     let expected = compliant::integrate(&bodies, &contacts, 400.0);
     let speed = 5.0 * 0.08; // tip speed of the pushed block (m/s)
-    for settings in [ImpactSettings::default(), ImpactSettings::adaptive(1e-6)] {
+                            // Energy: the fixed step books it exactly (to rounding); the adaptive
+                            // step's energy error is its tolerance times its number of steps.
+    for (settings, energy_tolerance) in [
+        (ImpactSettings::default(), 1e-6),
+        (ImpactSettings::adaptive(1e-8), 1e-4),
+    ] {
         let out = ImpactSolver::new()
             .solve(&bodies, &contacts, &settings)
             .unwrap();
@@ -67,8 +72,10 @@ fn domino_group_dissipates_and_both_step_controls_agree() {
     let fine = ImpactSolver::new()
         .solve(&bodies, &contacts, &ImpactSettings::fixed(1e-5))
         .unwrap();
+    // Event-heavy (e = 0 and stick/slip): the adaptive mode needs a tight
+    // tolerance here (README, work against precision).
     let adaptive = ImpactSolver::new()
-        .solve(&bodies, &contacts, &ImpactSettings::adaptive(1e-6))
+        .solve(&bodies, &contacts, &ImpactSettings::adaptive(1e-8))
         .unwrap();
     assert!(fixed.kinetic_energy_after < fixed.kinetic_energy_before);
     for out in [&fixed, &adaptive] {
@@ -79,50 +86,5 @@ fn domino_group_dissipates_and_both_step_controls_agree() {
     }
     for c in &fixed.contacts {
         assert!(c.normal_impulse >= 0.0);
-    }
-}
-
-#[test]
-#[ignore]
-fn explore_domino_group() {
-    let group = Leaning {
-        between: ContactMaterial::hertz(2.3e8)
-            .with_restitution(0.0)
-            .with_friction(0.075, 0.1),
-        ground: ContactMaterial::hertz(6.9e8)
-            .with_restitution(0.0)
-            .with_friction(0.45, 0.9),
-        ..elastic_group()
-    };
-    let (bodies, contacts) = group.build();
-    for s in [
-        ImpactSettings::fixed(1e-3),
-        ImpactSettings::fixed(1e-4),
-        ImpactSettings::fixed(1e-5),
-        ImpactSettings::adaptive(1e-3),
-        ImpactSettings::adaptive(1e-4),
-        ImpactSettings::adaptive(1e-5),
-        ImpactSettings::adaptive(1e-6),
-        ImpactSettings::adaptive(1e-8),
-    ] {
-        let t = std::time::Instant::now();
-        let out = ImpactSolver::new().solve(&bodies, &contacts, &s);
-        match out {
-            Ok(o) => eprintln!(
-                "{s:?}: steps {} rej {} in {:?} KE {} -> {} v0 {:?} vlast {:?} Pn {:?}",
-                o.steps,
-                o.rejected_steps,
-                t.elapsed(),
-                o.kinetic_energy_before,
-                o.kinetic_energy_after,
-                o.bodies[0],
-                o.bodies[19],
-                o.contacts
-                    .iter()
-                    .map(|c| (c.normal_impulse * 1e4).round() / 1e4)
-                    .collect::<Vec<_>>()
-            ),
-            Err(e) => eprintln!("{s:?}: {e} in {:?}", t.elapsed()),
-        }
     }
 }

@@ -21,12 +21,15 @@ pub enum StepControl {
         /// ΔP / P₀, dimensionless; the paper uses 10⁻⁴.
         impulse_step: f64,
     },
-    /// Step-doubling with Richardson extrapolation and step-size control: each
-    /// accepted step keeps its local error (velocities relative to the largest
-    /// approach speed, energies relative to the kinetic energy) below
-    /// `tolerance` per unit of P₀.
+    /// The same model integrated in the time of its contact law with an
+    /// embedded Runge–Kutta pair (Bogacki–Shampine 3(2)), step-size control
+    /// and landing on every mode change (see `impact::solver::timeline`).
+    /// Each accepted step keeps its local error below `tolerance`: contact
+    /// rates relative to the largest approach speed, compressions relative to
+    /// that speed times the two-body contact duration.
     Adaptive {
-        /// Relative error tolerance, dimensionless (e.g. 10⁻⁶).
+        /// Relative local error per step, dimensionless (e.g. 10⁻⁸); the error
+        /// of the result is about this times the number of steps.
         tolerance: f64,
     },
 }

@@ -30,6 +30,8 @@
 //! has closed. This makes the e = 1 result equal to the compliant model
 //! F = k δ^α integrated in time, separations and re-contacts included.
 
+mod timeline;
+
 use super::{
     validate, Body, BodyVelocity, Contact, ContactImpulse, ImpactError, ImpactOutcome,
     ImpactSettings, StepControl, StopReason,
@@ -56,6 +58,7 @@ struct Row {
     /// α/(α+1).
     power: f64,
     exponent: f64,
+    stiffness: f64,
     restitution: f64,
     friction: f64,
     stick_friction: f64,
@@ -63,7 +66,43 @@ struct Row {
     movable: bool,
 }
 
+/// A direction of impulse with its moment arms r×dir on the two bodies.
+#[derive(Clone, Copy, Debug)]
+struct Axis {
+    dir: [f64; 2],
+    arm_a: f64,
+    arm_b: f64,
+}
+
 impl Row {
+    /// F = k w^α from the energy-equivalent compression w (m); 0 for w ≤ 0.
+    #[inline]
+    fn stiffness_force(&self, w: f64) -> f64 {
+        if w <= 0.0 {
+            0.0
+        } else {
+            self.stiffness * w.powf(self.exponent)
+        }
+    }
+
+    #[inline]
+    fn normal_axis(&self) -> Axis {
+        Axis {
+            dir: self.normal,
+            arm_a: self.a_rn,
+            arm_b: self.b_rn,
+        }
+    }
+
+    #[inline]
+    fn tangent_axis(&self) -> Axis {
+        Axis {
+            dir: self.tangent,
+            arm_a: self.a_rt,
+            arm_b: self.b_rt,
+        }
+    }
+
     #[inline]
     fn force(&self, stored_energy: f64) -> f64 {
         if stored_energy <= 0.0 {
@@ -95,8 +134,6 @@ struct Scales {
     impulse: f64,
     /// Largest approach speed at the start (m/s).
     velocity: f64,
-    /// Kinetic energy at the start (J).
-    energy: f64,
     /// Rates above −threshold count as not approaching (m/s).
     threshold: f64,
 }
@@ -108,9 +145,6 @@ const MIN_LANDING: f64 = 1e-9;
 /// the velocity scale) below which they stop.
 const FRICTION_SWEEPS: usize = 16;
 const FRICTION_SETTLED: f64 = 1e-13;
-
-/// Relative differences below this are rounding, not truncation error.
-const ROUNDING: f64 = 1e-11;
 
 /// Result of one step attempt.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -180,11 +214,8 @@ pub struct ImpactSolver {
     scales: Scales,
     /// Impact time elapsed so far (s), from the contact law.
     elapsed: f64,
-    // Adaptive mode: state at the start of the step and after the full step.
-    saved_velocity: Vec<[f64; 3]>,
-    saved_state: Vec<ContactState>,
-    full_velocity: Vec<[f64; 3]>,
-    full_state: Vec<ContactState>,
+    /// Adaptive mode's buffers.
+    timeline: timeline::Timeline,
 }
 
 #[inline]
@@ -237,7 +268,7 @@ impl ImpactSolver {
                     self.run_fixed(impulse_step * self.scales.impulse, settings.max_steps, out)?
                 }
                 StepControl::Adaptive { tolerance } => {
-                    self.run_adaptive(tolerance, settings.max_steps, out)?
+                    self.run_timeline(tolerance, settings.max_steps, out)?
                 }
             }
         };
@@ -336,6 +367,7 @@ impl ImpactSolver {
                 force_coeff: a1.powf(m.exponent / a1) * m.stiffness.powf(1.0 / a1),
                 power: m.exponent / a1,
                 exponent: m.exponent,
+                stiffness: m.stiffness,
                 restitution: m.restitution,
                 friction: m.friction,
                 stick_friction: m.stick_friction,
@@ -346,8 +378,6 @@ impl ImpactSolver {
         let n = self.rows.len();
         let nb = self.velocity.len();
         self.trial.resize(nb, [0.0; 3]);
-        self.saved_velocity.resize(nb, [0.0; 3]);
-        self.full_velocity.resize(nb, [0.0; 3]);
         self.rate.resize(n, 0.0);
         self.rate_change.resize(n, 0.0);
         self.increment.resize(n, 0.0);
@@ -361,16 +391,12 @@ impl ImpactSolver {
         self.released.resize(n, false);
         self.state.clear();
         self.state.resize(n, ContactState::default());
-        self.saved_state.resize(n, ContactState::default());
-        self.full_state.resize(n, ContactState::default());
 
         // Scales: P₀, the velocity scale and the approach threshold.
         let mut momentum = [0.0, 0.0];
-        let mut energy = 0.0;
         for b in bodies.iter().filter(|b| !b.fixed) {
             momentum[0] += b.mass * b.velocity[0];
             momentum[1] += b.mass * b.velocity[1];
-            energy += b.kinetic_energy();
         }
         let mut speed: f64 = 0.0;
         let mut stopping_impulse: f64 = 0.0;
@@ -384,13 +410,9 @@ impl ImpactSolver {
                 stopping_impulse = stopping_impulse.max(-rate / row.w_nn);
             }
         }
-        let softest = self.rows.iter().map(|r| r.w_nn).fold(0.0, f64::max);
         self.scales = Scales {
             impulse: momentum[0].hypot(momentum[1]).max(stopping_impulse),
             velocity: speed,
-            // The kinetic energy, or the energy of the fastest approach on the
-            // most mobile contact when the bodies' own energy is smaller.
-            energy: energy.max(0.5 * speed * speed / softest.max(1e-300)),
             // Relative rounding noise left after landing on a switch.
             threshold: 1e-9 * speed,
         };
@@ -419,18 +441,17 @@ impl ImpactSolver {
             - va[2] * row.a_rt
     }
 
-    /// Applies impulse `p` along `dir` (arms `rn_a`, `rn_b`) to the row's bodies.
+    /// Applies impulse `p` along `axis` to the row's bodies.
     #[inline]
     fn apply(
         row: &Row,
-        dir: [f64; 2],
-        arm_a: f64,
-        arm_b: f64,
+        axis: Axis,
         p: f64,
         inv_mass: &[f64],
         inv_inertia: &[f64],
         v: &mut [[f64; 3]],
     ) {
+        let Axis { dir, arm_a, arm_b } = axis;
         let (ma, ia) = (inv_mass[row.a] * p, inv_inertia[row.a] * p);
         let va = &mut v[row.a];
         va[0] -= ma * dir[0];
@@ -594,9 +615,7 @@ impl ImpactSolver {
                     let row = &self.rows[i];
                     Self::apply(
                         row,
-                        row.normal,
-                        row.a_rn,
-                        row.b_rn,
+                        row.normal_axis(),
                         inc,
                         &self.inv_mass,
                         &self.inv_inertia,
@@ -678,9 +697,7 @@ impl ImpactSolver {
                         let row = &self.rows[i];
                         Self::apply(
                             row,
-                            row.normal,
-                            row.a_rn,
-                            row.b_rn,
+                            row.normal_axis(),
                             -self.increment[i] * scale * length,
                             &self.inv_mass,
                             &self.inv_inertia,
@@ -698,9 +715,7 @@ impl ImpactSolver {
                     let row = &self.rows[i];
                     Self::apply(
                         row,
-                        row.normal,
-                        row.a_rn,
-                        row.b_rn,
+                        row.normal_axis(),
                         inc,
                         &self.inv_mass,
                         &self.inv_inertia,
@@ -759,9 +774,7 @@ impl ImpactSolver {
                         self.tangent_step[i] = value;
                         Self::apply(
                             row,
-                            row.tangent,
-                            row.a_rt,
-                            row.b_rt,
+                            row.tangent_axis(),
                             change,
                             &self.inv_mass,
                             &self.inv_inertia,
@@ -836,7 +849,7 @@ impl ImpactSolver {
             if self.rows[i].movable && self.increment[i] == 0.0 && s.energy == 0.0 && dt.is_finite()
             {
                 let mid = 0.5 * (self.rate[i] + self.rate_change[i]);
-                s.gap = s.gap + mid * dt;
+                s.gap += mid * dt;
                 // closed when what is left is rounding of the landing
                 if s.gap <= 1e-9 * (mid.abs() * dt) {
                     s.gap = 0.0;
@@ -873,131 +886,6 @@ impl ImpactSolver {
         self.state[first].gap = 0.0;
         self.elapsed += shortest;
         Some(first)
-    }
-
-    /// Step doubling with Richardson extrapolation: the fixed step is first
-    /// order in h, so two half steps against one full step estimate the local
-    /// error, and 2·(halves) − (full) is second order.
-    fn run_adaptive(
-        &mut self,
-        tolerance: f64,
-        max_steps: usize,
-        out: &mut ImpactOutcome,
-    ) -> Result<StopReason, ImpactError> {
-        let p0 = self.scales.impulse;
-        let mut h = p0 * tolerance.sqrt().min(1e-2);
-        let h_min = p0 * 1e-14;
-        let mut attempts = 0usize;
-        loop {
-            attempts += 1;
-            if attempts >= max_steps {
-                return Err(ImpactError::StepLimit { steps: out.steps });
-            }
-            self.saved_velocity.copy_from_slice(&self.velocity);
-            self.saved_state.copy_from_slice(&self.state);
-            let elapsed = self.elapsed;
-            // The step length is the largest increment any contact takes.
-            let taken = match self.step(h, true) {
-                Step::Done => return Ok(StopReason::Released),
-                Step::Advanced { length } => length,
-            };
-            std::mem::swap(&mut self.full_velocity, &mut self.velocity);
-            std::mem::swap(&mut self.full_state, &mut self.state);
-            self.velocity.copy_from_slice(&self.saved_velocity);
-            self.state.copy_from_slice(&self.saved_state);
-            self.elapsed = elapsed;
-            // Two half steps without landing: the full step already stops short
-            // of the next switch.
-            let half = 0.5 * taken;
-            let mut finished = false;
-            for _ in 0..2 {
-                if self.step(half, false) == Step::Done {
-                    finished = true;
-                    break;
-                }
-            }
-            // Differences at the level of rounding are no error; the allowed
-            // error per step never falls below that level either.
-            let error = (self.difference() - ROUNDING).max(0.0);
-            // Error per unit step: the global error stays near `tolerance`
-            // times the total impulse over P₀.
-            let allowed = (tolerance * taken / p0).max(ROUNDING);
-            if error <= allowed || h <= h_min {
-                // Halves that ended the impact are kept as they are.
-                if !finished {
-                    self.extrapolate();
-                }
-                out.steps += 1;
-                if out.steps % 4096 == 0 && !self.finite() {
-                    return Err(ImpactError::NonFinite { steps: out.steps });
-                }
-                // local error ∝ h³ against an allowance ∝ h
-                let grow = if error > 0.0 {
-                    0.9 * (allowed / error).sqrt()
-                } else {
-                    4.0
-                };
-                h = (taken * grow.clamp(0.2, 4.0)).max(h_min);
-            } else {
-                out.rejected_steps += 1;
-                self.velocity.copy_from_slice(&self.saved_velocity);
-                self.state.copy_from_slice(&self.saved_state);
-                self.elapsed = elapsed;
-                let shrink = 0.9 * (allowed / error).sqrt();
-                h = (taken * shrink.clamp(0.1, 0.9)).max(h_min);
-            }
-        }
-    }
-
-    /// Local error estimate between the full step (`full_*`) and the two half
-    /// steps (current): contact rates relative to the velocity scale, stored
-    /// energies relative to the energy scale.
-    fn difference(&self) -> f64 {
-        let mut error: f64 = 0.0;
-        for (i, row) in self.rows.iter().enumerate() {
-            if !row.movable {
-                continue;
-            }
-            let dn = Self::normal_rate(row, &self.velocity)
-                - Self::normal_rate(row, &self.full_velocity);
-            let dt = Self::tangent_rate(row, &self.velocity)
-                - Self::tangent_rate(row, &self.full_velocity);
-            let de = self.state[i].energy - self.full_state[i].energy;
-            // A gap error shifts a re-contact by dg / V: compare with the time
-            // the impact has lasted.
-            let dg = self.state[i].gap - self.full_state[i].gap;
-            error = error
-                .max(dn.abs() / self.scales.velocity)
-                .max(dt.abs() / self.scales.velocity)
-                .max(de.abs() / self.scales.energy)
-                .max(dg.abs() / (self.scales.velocity * self.elapsed.max(1e-300)));
-        }
-        // Richardson: the halves' error is (y_half − y_full) / (2² − 1).
-        error / 3.0
-    }
-
-    /// Richardson for the second-order step: y ← (4·y_half − y_full)/3 for
-    /// velocities, energies, impulses and open gaps.
-    fn extrapolate(&mut self) {
-        let mix = |half: f64, full: f64| (4.0 * half - full) / 3.0;
-        for (v, f) in self.velocity.iter_mut().zip(&self.full_velocity) {
-            for k in 0..3 {
-                v[k] = mix(v[k], f[k]);
-            }
-        }
-        for (s, f) in self.state.iter_mut().zip(&self.full_state) {
-            if s.energy > 0.0 && f.energy > 0.0 {
-                s.energy = mix(s.energy, f.energy).max(0.0);
-            } else {
-                s.energy = 0.0;
-            }
-            if s.gap > 0.0 && f.gap > 0.0 {
-                s.gap = mix(s.gap, f.gap).max(0.0);
-            }
-            s.normal_impulse = mix(s.normal_impulse, f.normal_impulse).max(0.0);
-            s.tangent_impulse = mix(s.tangent_impulse, f.tangent_impulse);
-            s.peak_energy = s.peak_energy.max(s.energy);
-        }
     }
 }
 
