@@ -109,10 +109,9 @@ const NONE: usize = usize::MAX;
 /// }];
 /// let mut groups = ImpactGroups::default();
 /// let mut reports = Vec::new();
-/// # if groups.resolve(&mut bodies, &contacts, &ToppleSettings::default(), &mut reports).is_ok() {
+/// groups.resolve(&mut bodies, &contacts, &ToppleSettings::default(), &mut reports).unwrap();
 /// assert_eq!(reports.len(), 1);
 /// assert!((bodies[1].velocity[0] - 1.0).abs() < 1e-3);
-/// # }
 /// ```
 #[derive(Debug, Default)]
 pub struct ImpactGroups {
@@ -398,5 +397,130 @@ impl ImpactGroups {
             });
         }
         Ok(groups)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn ball(x: f64, vx: f64) -> Body {
+        Body::new(1.0, 0.004)
+            .with_position([x, 0.0])
+            .with_velocity([vx, 0.0])
+    }
+
+    fn touch(a: usize, b: usize, x: f64, persistent: bool) -> PointContact {
+        PointContact {
+            bodies: [Some(a), Some(b)],
+            point: [x, 0.0],
+            normal: [1.0, 0.0],
+            dist: 0.0,
+            material: ContactMaterial::hertz(1e8).with_restitution(0.0),
+            persistent,
+        }
+    }
+
+    #[test]
+    fn separate_pairs_are_separate_groups_and_conserve_momentum() {
+        // pair (0, 1) approaching, pair (2, 3) approaching, far apart
+        let mut bodies = [
+            ball(0.0, 1.0),
+            ball(0.2, 0.0),
+            ball(5.0, 0.0),
+            ball(5.2, -2.0),
+        ];
+        let contacts = [touch(0, 1, 0.1, false), touch(2, 3, 5.1, false)];
+        let mut reports = Vec::new();
+        let n = ImpactGroups::default()
+            .resolve(
+                &mut bodies,
+                &contacts,
+                &ToppleSettings::default(),
+                &mut reports,
+            )
+            .unwrap();
+        assert_eq!(n, 2);
+        assert_eq!((reports[0].bodies, reports[1].bodies), (2, 2));
+        // e = 0 between equal masses: both move at the mean velocity
+        for (pair, mean) in [([0, 1], 0.5), ([2, 3], -1.0)] {
+            for i in pair {
+                assert!(
+                    (bodies[i].velocity[0] - mean).abs() < 1e-3,
+                    "{i}: {:?}",
+                    bodies[i]
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn persistent_contacts_and_slow_approaches_start_nothing() {
+        let mut bodies = [ball(0.0, 1.0), ball(0.2, 0.0)];
+        let mut reports = Vec::new();
+        let mut groups = ImpactGroups::default();
+        let settings = ToppleSettings::default();
+        let persistent = [touch(0, 1, 0.1, true)];
+        assert_eq!(
+            groups
+                .resolve(&mut bodies, &persistent, &settings, &mut reports)
+                .unwrap(),
+            0
+        );
+        bodies[0].velocity[0] = 0.5 * settings.min_approach_speed;
+        let slow = [touch(0, 1, 0.1, false)];
+        assert_eq!(
+            groups
+                .resolve(&mut bodies, &slow, &settings, &mut reports)
+                .unwrap(),
+            0
+        );
+        assert!(reports.is_empty());
+    }
+
+    #[test]
+    fn fixed_bodies_do_not_join_groups_and_windows_cut_chains() {
+        // 0 → 1 touching a fixed wall 2 that also touches 3 (at rest)
+        let mut bodies = [
+            ball(0.0, 1.0),
+            ball(0.2, 0.0),
+            Body::fixed(),
+            ball(0.6, 0.0),
+        ];
+        bodies[2].position = [0.4, 0.0];
+        let contacts = [
+            touch(0, 1, 0.1, false),
+            touch(1, 2, 0.3, false),
+            touch(2, 3, 0.5, false),
+        ];
+        let mut reports = Vec::new();
+        let mut groups = ImpactGroups::default();
+        groups
+            .resolve(
+                &mut bodies,
+                &contacts,
+                &ToppleSettings::default(),
+                &mut reports,
+            )
+            .unwrap();
+        assert_eq!((reports[0].bodies, reports[0].contacts), (2, 2));
+        assert_eq!(bodies[3].velocity, [0.0, 0.0]);
+        // chain 0-1-2-3-4 of free balls; a window of 1 contact keeps 0, 1, 2
+        let mut chain: Vec<Body> = (0..5)
+            .map(|i| ball(0.2 * i as f64, if i == 0 { 1.0 } else { 0.0 }))
+            .collect();
+        let links: Vec<PointContact> = (0..4)
+            .map(|i| touch(i, i + 1, 0.2 * i as f64 + 0.1, false))
+            .collect();
+        let settings = ToppleSettings {
+            max_group_hops: Some(1),
+            ..ToppleSettings::default()
+        };
+        reports.clear();
+        groups
+            .resolve(&mut chain, &links, &settings, &mut reports)
+            .unwrap();
+        assert_eq!((reports[0].bodies, reports[0].contacts), (3, 2));
+        assert_eq!(chain[3].velocity, [0.0, 0.0]);
     }
 }

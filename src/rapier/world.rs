@@ -60,10 +60,9 @@ pub struct ToppleStats {
 ///     topple.manage(&mut world.colliders, collider, steel);
 ///     balls.push(body);
 /// }
-/// # if topple.step(&mut world).is_ok() {
+/// topple.step(&mut world).unwrap();
 /// assert!(world.bodies[balls[0]].linvel().x.abs() < 1e-3);
 /// assert!((world.bodies[balls[1]].linvel().x - 1.0).abs() < 1e-3);
-/// # }
 /// ```
 #[derive(Debug)]
 pub struct ToppleRapier {
