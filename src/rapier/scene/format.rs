@@ -247,6 +247,42 @@ pub struct RowSpec {
     /// Block density (kg/m² per unit depth).
     #[serde(default = "default_density")]
     pub density: f64,
+    /// Block mass (kg); overrides density.
+    #[serde(default)]
+    pub mass: Option<f64>,
+    /// Overrides of the preset (applied after `ideal`).
+    #[serde(default, flatten)]
+    pub overrides: RowOverrides,
+}
+
+/// Values that replace the preset's (Table 1) in a row.
+#[derive(Clone, Debug, Default, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RowOverrides {
+    /// Block height h (m).
+    pub height: Option<f64>,
+    /// Block thickness d (m).
+    pub thickness: Option<f64>,
+    /// Sliding friction between blocks μ₁ (sets μ₁ˢ too unless given).
+    pub mu1: Option<f64>,
+    /// Sticking friction between blocks μ₁ˢ.
+    pub mu1_stick: Option<f64>,
+    /// Restitution between blocks e₁.
+    pub e1: Option<f64>,
+    /// Stiffness between blocks k₁ (N/m^α).
+    pub k1: Option<f64>,
+    /// Sliding friction with the ground μ₂ (sets μ₂ˢ too unless given).
+    pub mu2: Option<f64>,
+    /// Sticking friction with the ground μ₂ˢ.
+    pub mu2_stick: Option<f64>,
+    /// Restitution with the ground e₂.
+    pub e2: Option<f64>,
+    /// Stiffness with the ground k₂ (N/m^α).
+    pub k2: Option<f64>,
+    /// Exponent α of the contact law (1.5).
+    pub alpha: Option<f64>,
+    /// Factor on μ inside impacts (0.5).
+    pub impact_friction_factor: Option<f64>,
 }
 
 fn default_density() -> f64 {

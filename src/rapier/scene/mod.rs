@@ -9,7 +9,8 @@ mod run;
 
 pub use build::{build, topple_settings, Engine, RowInfo, SceneWorld};
 pub use format::{
-    BodySpec, GroundSpec, MaterialSpec, PairLaw, PairSpec, RowSpec, Scene, ShapeKind, SolverSpec,
+    BodySpec, GroundSpec, MaterialSpec, PairLaw, PairSpec, RowOverrides, RowSpec, Scene, ShapeKind,
+    SolverSpec,
 };
 pub use row::{expand_row, preset, Preset, RowMeasures};
 pub use run::{

@@ -40,25 +40,46 @@ pub fn preset(name: &str) -> Option<Preset> {
 }
 
 /// Adds the row's materials ("block", "ground"), pair rules, ground and
-/// blocks ("block1" …) to a scene. Blocks stand on the ground at y = 0,
+/// blocks ("block1" …) to a scene; returns the preset with the overrides
+/// applied. Blocks stand on the ground at y = 0,
 /// block i (from 1) centred at x = (i − 1)(s + d); block 1 rotates clockwise
 /// about its front bottom edge at θ̇ = push/t̄.
 pub fn expand_row(scene: &mut Scene, row: &RowSpec) -> anyhow::Result<Preset> {
-    let p = preset(&row.preset)
+    let mut p = preset(&row.preset)
         .ok_or_else(|| anyhow::anyhow!("unknown domino preset {:?} (X, T or P)", row.preset))?;
-    let [mut mu1, mut mus1, mut e1, k1] = p.block;
-    let [mut mu2, mut mus2, mut e2, k2] = p.ground;
+    let [mut mu1, mut mus1, mut e1, mut k1] = p.block;
+    let [mut mu2, mut mus2, mut e2, mut k2] = p.ground;
     if row.ideal {
         (mu1, mus1, e1) = (0.0, 0.0, 0.0);
         (mu2, mus2, e2) = (0.9, 0.9, 0.0);
     }
+    let o = &row.overrides;
+    let set = |x: &mut f64, v: Option<f64>| {
+        if let Some(v) = v {
+            *x = v;
+        }
+    };
+    set(&mut p.height, o.height);
+    set(&mut p.thickness, o.thickness);
+    set(&mut mu1, o.mu1);
+    set(&mut mus1, o.mu1_stick.or(o.mu1));
+    set(&mut e1, o.e1);
+    set(&mut k1, o.k1);
+    set(&mut mu2, o.mu2);
+    set(&mut mus2, o.mu2_stick.or(o.mu2));
+    set(&mut e2, o.e2);
+    set(&mut k2, o.k2);
+    p.block = [mu1, mus1, e1, k1];
+    p.ground = [mu2, mus2, e2, k2];
+    let alpha = o.alpha.unwrap_or(1.5);
+    let factor = o.impact_friction_factor.unwrap_or(0.5);
     let law = |mu, mus, e, k| PairLaw {
         stiffness: k,
-        exponent: 1.5,
+        exponent: alpha,
         restitution: e,
         friction: mu,
         stick_friction: mus,
-        impact_friction_factor: 0.5,
+        impact_friction_factor: factor,
     };
     let block = law(mu1, mus1, e1, k1);
     let ground = law(mu2, mus2, e2, k2);
@@ -107,7 +128,7 @@ pub fn expand_row(scene: &mut Scene, row: &RowSpec) -> anyhow::Result<Preset> {
             velocity,
             angular_velocity,
             density: Some(row.density),
-            mass: None,
+            mass: row.mass,
             fixed: false,
             material: "block".into(),
         });
