@@ -19,6 +19,18 @@ use super::patch::PatchRule;
 
 /// A contact point between two bodies (indices into the body slice; `None` is
 /// the fixed world) at the current positions.
+///
+/// ```
+/// use topple::impact::{Body, ContactMaterial};
+/// use topple::rapier::{normal_velocity, PointContact};
+/// // a ball falling at 2 m/s onto the ground (the world is the first body)
+/// let bodies = [Body::new(1.0, 0.004).with_position([0.0, 0.1]).with_velocity([0.0, -2.0])];
+/// let c = PointContact {
+///     bodies: [None, Some(0)], point: [0.0, 0.0], normal: [0.0, 1.0], dist: 0.0,
+///     material: ContactMaterial::hertz(1e8), persistent: false,
+/// };
+/// assert_eq!(normal_velocity(&bodies, &c), -2.0);
+/// ```
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct PointContact {
     /// First and second body; the normal points from the first to the second.
@@ -74,6 +86,11 @@ impl Default for ToppleSettings {
 }
 
 /// What one resolved impact did.
+///
+/// ```
+/// let r = topple::rapier::ImpactReport::default();
+/// assert!(r.kinetic_energy_after <= r.kinetic_energy_before);
+/// ```
 #[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize)]
 pub struct ImpactReport {
     /// Free bodies in the group.

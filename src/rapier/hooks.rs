@@ -9,6 +9,12 @@ use rapier2d_f64::prelude::{
 use super::material::{MaterialId, MaterialTable, PairMaterial};
 
 /// Who resolves impacts on managed pairs.
+///
+/// ```
+/// use topple::rapier::{HookMode, ToppleRapier, ToppleSettings};
+/// assert_eq!(ToppleRapier::new(ToppleSettings::default()).hooks().mode(), HookMode::Topple);
+/// assert_eq!(ToppleRapier::native().hooks().mode(), HookMode::Native);
+/// ```
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum HookMode {
     /// topple resolves impacts; Rapier keeps resting contact with restitution 0
@@ -22,6 +28,20 @@ pub enum HookMode {
 }
 
 /// Materials of the managed colliders, read by the hook during Rapier's step.
+/// Hand it to `PhysicsPipeline::step` (see [`super::ToppleRapier::hooks`]).
+///
+/// ```
+/// use rapier2d_f64::prelude::*;
+/// use topple::impact::ContactMaterial;
+/// use topple::rapier::{PairMaterial, ToppleRapier, ToppleSettings};
+/// let mut colliders = ColliderSet::new();
+/// let c = colliders.insert(ColliderBuilder::ball(0.1));
+/// let mut topple = ToppleRapier::new(ToppleSettings::default());
+/// let m = topple.add_material(PairMaterial { impact: ContactMaterial::hertz(1e9), smooth_friction: 0.4 });
+/// topple.manage(&mut colliders, c, m);
+/// assert_eq!(topple.hooks().material_of(c), Some(m));
+/// assert_eq!(topple.hooks().pair(c, c).unwrap().smooth_friction, 0.4);
+/// ```
 #[derive(Clone, Debug)]
 pub struct ToppleHooks {
     pub(crate) table: MaterialTable,
@@ -70,6 +90,11 @@ impl ToppleHooks {
         now.sort_unstable();
         now.dedup();
         std::mem::swap(&mut self.closed, now);
+    }
+
+    /// Who resolves impacts.
+    pub fn mode(&self) -> HookMode {
+        self.mode
     }
 
     /// The material of a collider, if topple manages it.

@@ -8,6 +8,12 @@
 //! contact law, as the paper does for the base of a standing block.
 
 /// One point of a contact manifold at the current positions (world frame, m).
+///
+/// ```
+/// use topple::rapier::ManifoldPoint;
+/// let p = ManifoldPoint { point: [0.0, 0.0], dist: -1e-6 }; // penetrating by 1 µm
+/// assert!(p.dist < 0.0);
+/// ```
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct ManifoldPoint {
     /// Contact point (m), e.g. the midpoint of the two bodies' witness points.
@@ -17,6 +23,12 @@ pub struct ManifoldPoint {
 }
 
 /// How a manifold becomes resolver contact points.
+///
+/// ```
+/// use topple::rapier::PatchRule;
+/// let paper = PatchRule { lambda: 9, ..PatchRule::default() };
+/// assert!(paper.closed_tolerance >= 0.0);
+/// ```
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct PatchRule {
     /// A point is closed (takes part in impacts) when its gap is at most this (m).

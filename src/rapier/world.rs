@@ -18,6 +18,11 @@ use super::material::{MaterialId, PairMaterial};
 use super::patch::{for_each_contact_point, ManifoldPoint};
 
 /// Running totals over all resolve passes.
+///
+/// ```
+/// use topple::rapier::{ToppleRapier, ToppleSettings};
+/// assert_eq!(ToppleRapier::new(ToppleSettings::default()).stats().impacts, 0);
+/// ```
 #[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize)]
 pub struct ToppleStats {
     /// Candidate pairs queried at the current positions.

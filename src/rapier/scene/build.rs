@@ -15,6 +15,11 @@ use super::format::{PairLaw, Scene, ShapeKind, SolverSpec};
 use super::row::{expand_row, Preset};
 
 /// Who resolves impacts.
+///
+/// ```
+/// use topple::rapier::scene::Engine;
+/// assert_eq!(Engine::RapierNative.name(), "rapier-native");
+/// ```
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default, serde::Serialize, clap::ValueEnum)]
 #[serde(rename_all = "kebab-case")]
 pub enum Engine {
@@ -97,6 +102,21 @@ pub fn topple_settings(s: &SolverSpec, gravity: [f64; 2]) -> ToppleSettings {
 }
 
 /// Builds the world of a scene for an engine.
+///
+/// ```
+/// use topple::rapier::scene::{build, Engine, Scene};
+/// let scene: Scene = toml::from_str(r#"
+///     duration = 0.1
+///     [row]
+///     preset = "T"
+///     n = 3
+///     spacing = 0.35
+/// "#).unwrap();
+/// let mut sw = build(&scene, Engine::Rapier).unwrap();
+/// assert_eq!(sw.bodies.len(), 3);
+/// sw.step().unwrap();
+/// assert!(sw.kinetic_energy() > 0.0); // block 1 is pushed
+/// ```
 pub fn build(scene: &Scene, engine: Engine) -> anyhow::Result<SceneWorld> {
     let mut scene = scene.clone();
     let row = match scene.row.clone() {

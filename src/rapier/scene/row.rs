@@ -137,6 +137,14 @@ pub fn expand_row(scene: &mut Scene, row: &RowSpec) -> anyhow::Result<Preset> {
 }
 
 /// The wave measures of a row: hit times and dimensionless speeds.
+///
+/// ```
+/// use topple::rapier::scene::RowMeasures;
+/// // 10 blocks, one pitch (s + d = 0.1 m) every 0.05 s, h = 0.1 m, g = 10
+/// let hits: Vec<f64> = (0..10).map(|i| 0.05 * i as f64).collect();
+/// let m = RowMeasures::from_hit_times(hits, 10, 0.09, 0.01, 0.1, 10.0);
+/// assert!((m.natural_speed.unwrap() - 2.0).abs() < 1e-12);
+/// ```
 #[derive(Clone, Debug, Default, PartialEq, serde::Serialize)]
 pub struct RowMeasures {
     /// T_i: time block i − 1 hit block i (s); T_1 = 0 (block 1 is pushed).

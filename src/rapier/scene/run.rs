@@ -117,6 +117,33 @@ impl HitTracker {
 }
 
 /// Runs a scene with an engine.
+///
+/// ```
+/// use topple::rapier::scene::{run_scene, Engine, RunOptions, Scene};
+/// let scene: Scene = toml::from_str(r#"
+///     duration = 0.01
+///     gravity = [0.0, 0.0]
+///     [[materials]]
+///     name = "steel"
+///     stiffness = 1e10
+///     [[bodies]]
+///     shape = "ball"
+///     radius = 0.05
+///     position = [0.0, 0.0]
+///     velocity = [1.0, 0.0]
+///     mass = 1.0
+///     material = "steel"
+///     [[bodies]]
+///     shape = "ball"
+///     radius = 0.05
+///     position = [0.1, 0.0]
+///     mass = 1.0
+///     material = "steel"
+/// "#).unwrap();
+/// let out = run_scene(&scene, Engine::Rapier, RunOptions::default()).unwrap();
+/// assert_eq!(out.impacts.len(), 1);
+/// assert!((out.bodies[1].velocity[0] - 1.0).abs() < 1e-3);
+/// ```
 pub fn run_scene(
     scene: &Scene,
     engine: Engine,
