@@ -609,20 +609,14 @@ impl ImpactSolver {
         let mut released_now = false;
         if land {
             self.trial.copy_from_slice(&self.velocity);
-            for i in 0..n {
-                let inc = self.increment[i] * scale;
-                if inc > 0.0 {
-                    let row = &self.rows[i];
-                    Self::apply(
-                        row,
-                        row.normal_axis(),
-                        inc,
-                        &self.inv_mass,
-                        &self.inv_inertia,
-                        &mut self.trial,
-                    );
-                }
-            }
+            apply_increments(
+                &self.rows,
+                &self.increment,
+                scale,
+                &self.inv_mass,
+                &self.inv_inertia,
+                &mut self.trial,
+            );
             for i in 0..n {
                 let row = &self.rows[i];
                 if !row.movable {
@@ -709,20 +703,14 @@ impl ImpactSolver {
                 }
             }
         } else {
-            for i in 0..n {
-                let inc = self.increment[i] * scale;
-                if inc > 0.0 {
-                    let row = &self.rows[i];
-                    Self::apply(
-                        row,
-                        row.normal_axis(),
-                        inc,
-                        &self.inv_mass,
-                        &self.inv_inertia,
-                        &mut self.velocity,
-                    );
-                }
-            }
+            apply_increments(
+                &self.rows,
+                &self.increment,
+                scale,
+                &self.inv_mass,
+                &self.inv_inertia,
+                &mut self.velocity,
+            );
         }
         let factor = scale * length;
         for inc in &mut self.increment[..n] {
@@ -886,6 +874,23 @@ impl ImpactSolver {
         self.state[first].gap = 0.0;
         self.elapsed += shortest;
         Some(first)
+    }
+}
+
+/// Applies every contact's normal increment, times `scale`, to `v`.
+fn apply_increments(
+    rows: &[Row],
+    increment: &[f64],
+    scale: f64,
+    inv_mass: &[f64],
+    inv_inertia: &[f64],
+    v: &mut [[f64; 3]],
+) {
+    for (row, inc) in rows.iter().zip(increment) {
+        let p = inc * scale;
+        if p > 0.0 {
+            ImpactSolver::apply(row, row.normal_axis(), p, inv_mass, inv_inertia, v);
+        }
     }
 }
 
