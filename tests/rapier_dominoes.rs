@@ -21,6 +21,7 @@ fn ideal_row(spacing: f64, n: usize, dt: f64) -> Scene {
 fn natural_speed(scene: &Scene, engine: Engine) -> f64 {
     let options = RunOptions {
         stop_after_last_hit: true,
+        ..RunOptions::default()
     };
     let out = run_scene(scene, engine, options).unwrap();
     let row = out.row.unwrap();

@@ -18,6 +18,9 @@ pub struct Args {
     /// Stop a domino-row scene once its last block has been hit.
     #[arg(long)]
     pub until_last_hit: bool,
+    /// If an impact cannot be resolved, write it here (input of `topple impact`).
+    #[arg(long)]
+    pub dump_failed_impact: Option<PathBuf>,
 }
 
 /// Runs the scene and prints final body states and the impacts resolved.
@@ -25,6 +28,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     let scene = load_scene(&args.file)?;
     let options = RunOptions {
         stop_after_last_hit: args.until_last_hit,
+        dump_failed_impact: args.dump_failed_impact.clone(),
     };
     let out = run_scene(&scene, args.engine, options)?;
     if args.json {

@@ -183,6 +183,12 @@ fn find(parent: &mut [usize], mut i: usize) -> usize {
 }
 
 impl ImpactGroups {
+    /// The bodies and contacts of the group solved last, in the resolver's
+    /// input form (after an error: the group that failed).
+    pub fn last_group(&self) -> (&[Body], &[Contact]) {
+        (&self.group_bodies, &self.group_contacts)
+    }
+
     /// Resolves every impact found in `contacts` and writes the post-impact
     /// velocities into `bodies`; appends one report per group to `reports` and
     /// returns the number of groups. Bodies with `fixed` never move and do not

@@ -181,6 +181,11 @@ impl ToppleRapier {
         &self.reports
     }
 
+    /// The grouping stage (e.g. [`ImpactGroups::last_group`] after an error).
+    pub fn impact_groups(&self) -> &ImpactGroups {
+        &self.groups
+    }
+
     /// Totals since creation.
     pub fn stats(&self) -> ToppleStats {
         self.stats

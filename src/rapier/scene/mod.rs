@@ -14,5 +14,6 @@ pub use format::{
 };
 pub use row::{expand_row, preset, Preset, RowMeasures};
 pub use run::{
-    load_scene, run_scene, signed_gap, BodyState, HitTracker, RunOptions, SceneOutput, TimedImpact,
+    impact_input_json, load_scene, run_scene, signed_gap, BodyState, HitTracker, RunOptions,
+    SceneOutput, TimedImpact,
 };

@@ -56,10 +56,38 @@ pub struct SceneOutput {
 }
 
 /// Options of [`run_scene`].
-#[derive(Clone, Copy, Debug, Default)]
+#[derive(Clone, Debug, Default)]
 pub struct RunOptions {
     /// Stop a row scene once its last block has been hit.
     pub stop_after_last_hit: bool,
+    /// If the resolver fails, write the failing group here as input for
+    /// `topple impact`.
+    pub dump_failed_impact: Option<std::path::PathBuf>,
+}
+
+/// The group solved last by topple in the `topple impact` input format.
+pub fn impact_input_json(sw: &SceneWorld) -> serde_json::Value {
+    let (bodies, contacts) = sw.topple.impact_groups().last_group();
+    let settings = sw.topple.settings().impact;
+    let (impulse_step, tolerance) = match settings.step_control {
+        crate::impact::StepControl::Fixed { impulse_step } => (impulse_step, None),
+        crate::impact::StepControl::Adaptive { tolerance } => (1e-4, Some(tolerance)),
+    };
+    let contacts: Vec<serde_json::Value> = contacts
+        .iter()
+        .map(|c| {
+            serde_json::json!({
+                "bodies": c.bodies, "point": c.point, "normal": c.normal,
+                "stiffness": c.material.stiffness, "exponent": c.material.exponent,
+                "restitution": c.material.restitution, "friction": c.material.friction,
+                "stick_friction": c.material.stick_friction,
+            })
+        })
+        .collect();
+    serde_json::json!({
+        "bodies": bodies, "contacts": contacts,
+        "impulse_step": impulse_step, "tolerance": tolerance,
+    })
 }
 
 /// Signed gap between two colliders (m): negative when penetrating.
@@ -158,7 +186,16 @@ pub fn run_scene(
     let mut taken = 0;
     for _ in 0..steps {
         let time = sw.time + dt;
-        let reports = sw.step()?;
+        let reports = match sw.step() {
+            Ok(r) => r,
+            Err(e) => {
+                if let Some(path) = &options.dump_failed_impact {
+                    let json = serde_json::to_string_pretty(&impact_input_json(&sw))?;
+                    std::fs::write(path, json)?;
+                }
+                return Err(e.context(format!("at t = {time:.6} s")));
+            }
+        };
         impacts.extend(reports.iter().map(|&report| TimedImpact { time, report }));
         taken += 1;
         if let Some(row) = &sw.row {
