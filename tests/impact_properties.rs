@@ -83,9 +83,19 @@ fn momentum(bodies: &[Body], velocities: &[[f64; 2]]) -> [f64; 2] {
 }
 
 fn check(p: &Problem, step_control: StepControl, free: bool) -> Result<(), TestCaseError> {
+    check_with(p, step_control, free, false)
+}
+
+fn check_with(
+    p: &Problem,
+    step_control: StepControl,
+    free: bool,
+    e0_hold: bool,
+) -> Result<(), TestCaseError> {
     let settings = ImpactSettings {
         step_control,
         max_steps: 100_000,
+        e0_hold,
     };
     match ImpactSolver::new().solve(&p.bodies, &p.contacts, &settings) {
         // a jammed configuration (e.g. a body wedged between opposing
@@ -132,7 +142,13 @@ fn check(p: &Problem, step_control: StepControl, free: bool) -> Result<(), TestC
 }
 
 proptest! {
-    #![proptest_config(ProptestConfig { cases: 96, ..ProptestConfig::default() })]
+    // A fixed seed keeps CI reproducible; raise PROPTEST_CASES locally to
+    // explore further.
+    #![proptest_config(ProptestConfig {
+        cases: 96,
+        rng_seed: proptest::test_runner::RngSeed::Fixed(0x7099_1e00),
+        ..ProptestConfig::default()
+    })]
 
     #[test]
     fn fixed_step_with_world(p in problem(true)) {
@@ -142,6 +158,11 @@ proptest! {
     #[test]
     fn fixed_step_free_bodies(p in problem(false)) {
         check(&p, StepControl::Fixed { impulse_step: 1e-3 }, true)?;
+    }
+
+    #[test]
+    fn fixed_step_held_e0_contacts(p in problem(true)) {
+        check_with(&p, StepControl::Fixed { impulse_step: 1e-3 }, false, true)?;
     }
 
     #[test]

@@ -189,3 +189,45 @@ fn results_are_deterministic() {
         .unwrap();
     assert_eq!(a, b);
 }
+
+#[test]
+fn held_e0_chain_moves_as_one_body() {
+    // With e = 0 and `e0_hold`, every contact ends held closed: a row of
+    // touching balls struck at one end ends moving together at the common
+    // velocity momentum gives (perfectly plastic), v₁ m₁ / Σ m.
+    for n in [2usize, 3, 5] {
+        let masses: Vec<f64> = (0..n).map(|i| 1.0 + 0.5 * i as f64).collect();
+        let bodies: Vec<Body> = (0..n)
+            .map(|i| {
+                Body::new(masses[i], 0.01)
+                    .with_position([0.2 * i as f64, 0.0])
+                    .with_velocity([if i == 0 { 2.0 } else { 0.0 }, 0.0])
+            })
+            .collect();
+        let contacts: Vec<Contact> = (0..n - 1)
+            .map(|j| {
+                Contact::new(
+                    [Some(j), Some(j + 1)],
+                    [0.2 * j as f64 + 0.1, 0.0],
+                    [1.0, 0.0],
+                    material(0.0, 1.5),
+                )
+            })
+            .collect();
+        let settings = ImpactSettings {
+            e0_hold: true,
+            ..ImpactSettings::default()
+        };
+        let out = ImpactSolver::new()
+            .solve(&bodies, &contacts, &settings)
+            .unwrap();
+        let common = 2.0 * masses[0] / masses.iter().sum::<f64>();
+        for b in &out.bodies {
+            assert!(
+                (b.velocity[0] - common).abs() < 1e-6,
+                "n = {n}: {} vs {common}",
+                b.velocity[0]
+            );
+        }
+    }
+}

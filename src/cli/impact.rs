@@ -27,6 +27,10 @@ pub struct Args {
     /// Largest number of impulse steps before giving up.
     #[arg(long, default_value_t = 10_000_000)]
     pub max_steps: usize,
+    /// Hold e = 0 contacts closed once their compression ends (a plastic
+    /// constraint) instead of the paper's release-and-reload law.
+    #[arg(long)]
+    pub e0_hold: bool,
 }
 
 #[derive(Deserialize)]
@@ -99,13 +103,13 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         std::fs::read_to_string(&args.file)
             .with_context(|| format!("reading {}", args.file.display()))?
     };
-    let output = resolve_json(&text, args.max_steps)?;
+    let output = resolve_json(&text, args.max_steps, args.e0_hold)?;
     println!("{output}");
     Ok(())
 }
 
 /// The whole command as a function of the input text.
-fn resolve_json(text: &str, max_steps: usize) -> anyhow::Result<String> {
+fn resolve_json(text: &str, max_steps: usize, e0_hold: bool) -> anyhow::Result<String> {
     // serde_json rejects NaN and infinities in JSON text already; the resolver
     // re-checks every value.
     let input: Input = serde_json::from_str(text).context("invalid input JSON")?;
@@ -147,6 +151,7 @@ fn resolve_json(text: &str, max_steps: usize) -> anyhow::Result<String> {
     let settings = ImpactSettings {
         step_control,
         max_steps,
+        e0_hold,
     };
     let out = ImpactSolver::new().solve(&bodies, &contacts, &settings)?;
     let output = Output {

@@ -55,6 +55,16 @@ pub struct ImpactSettings {
     /// A runaway impact stops with [`crate::impact::ImpactError::StepLimit`]
     /// after this many steps (default 10⁷).
     pub max_steps: usize,
+    /// e = 0 contacts (fixed step only). `false` (default, the paper's law):
+    /// the energy is lost when compression ends and a contact that is still
+    /// pushed loads again from zero, cycle after cycle, each cycle dissipating
+    /// what it stored. `true`: a contact whose compression has ended without
+    /// separating is held closed by a non-negative impulse that does no work
+    /// (a plastic unilateral constraint). Faster by orders of magnitude on
+    /// wedged trains of blocks, and less dissipative: a different model, not
+    /// a refinement of the default.
+    #[serde(default)]
+    pub e0_hold: bool,
 }
 
 impl Default for ImpactSettings {
@@ -62,6 +72,7 @@ impl Default for ImpactSettings {
         ImpactSettings {
             step_control: StepControl::default(),
             max_steps: 10_000_000,
+            e0_hold: false,
         }
     }
 }

@@ -125,6 +125,9 @@ struct ContactState {
     gap: f64,
     /// Stick (true) or slip (false) for the friction law.
     sticking: bool,
+    /// e = 0 contact whose compression has ended without separating: held
+    /// closed by a non-negative impulse (the sliding-mode limit of e = 0).
+    held: bool,
 }
 
 /// Scales of one impact, fixed at its start.
@@ -206,14 +209,17 @@ pub struct ImpactSolver {
     mid_velocity: Vec<[f64; 3]>,
     mid_state: Vec<ContactState>,
     mid_energy: Vec<f64>,
-    /// Tangential increments of the step and stick state at its start.
+    /// Tangential and held normal increments of the step, stick state at its start.
     tangent_step: Vec<f64>,
+    held_step: Vec<f64>,
     stuck_at_start: Vec<bool>,
     /// Contacts whose last bit of energy is released without a step.
     released: Vec<bool>,
     scales: Scales,
     /// Impact time elapsed so far (s), from the contact law.
     elapsed: f64,
+    /// See [`ImpactSettings::e0_hold`].
+    e0_hold: bool,
     /// Adaptive mode's buffers.
     timeline: timeline::Timeline,
 }
@@ -256,6 +262,7 @@ impl ImpactSolver {
         validate::check(bodies, contacts, settings)?;
         self.load(bodies, contacts);
         self.elapsed = 0.0;
+        self.e0_hold = settings.e0_hold;
         out.kinetic_energy_before = bodies.iter().map(Body::kinetic_energy).sum();
         out.steps = 0;
         out.rejected_steps = 0;
@@ -385,6 +392,7 @@ impl ImpactSolver {
         self.mid_state.resize(n, ContactState::default());
         self.mid_energy.resize(n, 0.0);
         self.tangent_step.resize(n, 0.0);
+        self.held_step.resize(n, 0.0);
         self.stuck_at_start.clear();
         self.stuck_at_start.resize(n, false);
         self.released.clear();
@@ -532,17 +540,22 @@ impl ImpactSolver {
             let rate = Self::normal_rate(row, &self.velocity);
             self.rate[i] = rate;
             let s = &mut self.state[i];
-            // e = 0: the energy is lost as soon as expansion starts. Rates
-            // within the rounding band count as neither compression nor
-            // expansion, so a contact held closed keeps its force.
-            if s.energy > 0.0 && rate > threshold && row.restitution == 0.0 {
+            // e = 0: the energy is lost when compression ends (errata §2).
+            // With `e0_hold`, a contact that does not separate then is held
+            // closed (a plastic unilateral constraint, see ImpactSettings).
+            if row.restitution == 0.0 && s.energy > 0.0 && rate >= -threshold {
                 s.energy = 0.0;
+                s.held = self.e0_hold && rate <= threshold;
+            }
+            if s.held && rate < -threshold {
+                // approaching again with nothing holding it: a new impact
+                s.held = false;
             }
             if s.energy > largest_energy {
                 largest_energy = s.energy;
                 primary = i;
             }
-            if s.energy == 0.0 && s.gap == 0.0 && rate < fastest_rate {
+            if s.energy == 0.0 && s.gap == 0.0 && !s.held && rate < fastest_rate {
                 fastest_rate = rate;
                 fastest = i;
             }
@@ -592,7 +605,7 @@ impl ImpactSolver {
                 0.0
             } else if ratio_energy > 0.0 {
                 h * row.force(ratio_energy) / primary_force
-            } else if s.gap == 0.0 && rate < -threshold {
+            } else if s.gap == 0.0 && !s.held && rate < -threshold {
                 (h * row.force_coeff / primary_force).powf(row.exponent + 1.0)
                     * (-rate).powf(row.exponent)
             } else {
@@ -630,14 +643,6 @@ impl ImpactSolver {
                 let at = if inc > 0.0 && rate < -threshold && rate + change > 0.0 {
                     // compression ends
                     -rate / change
-                } else if inc > 0.0 && row.restitution == 0.0 && s.energy > 0.0 {
-                    // e = 0 at the end of compression: if this step would
-                    // open it, its energy goes without impulse (errata §2)
-                    if rate + change > threshold {
-                        released_now = true;
-                        self.released[i] = true;
-                    }
-                    1.0
                 } else if inc > 0.0 && rate >= -threshold && s.energy > 0.0 {
                     // expansion: release(σ) = σ inc (rate + σ change / 2) / e² reaches E
                     let e2 = row.restitution * row.restitution;
@@ -657,6 +662,7 @@ impl ImpactSolver {
                 } else if inc == 0.0
                     && s.energy == 0.0
                     && s.gap == 0.0
+                    && !s.held
                     && rate + change < -threshold
                 {
                     // a resting closed contact starts to approach: land just
@@ -717,27 +723,53 @@ impl ImpactSolver {
             *inc *= factor;
         }
 
-        // 5. Coulomb friction: projected Gauss–Seidel sweeps over this step's
-        // tangential increments until the slip corrections are rounding.
-        // A contact sticking at the start of the step stays stuck while that
-        // needs |dP_t| ≤ μ_s dP_n, a sliding one sticks when |dP_t| ≤ μ dP_n
-        // stops its slip; otherwise |dP_t| = μ dP_n against the slip.
-        let mut frictional = false;
+        // 5. Held contacts and Coulomb friction: projected Gauss–Seidel sweeps
+        // over this step's held normal and tangential increments until the
+        // corrections are rounding. A held contact takes the non-negative
+        // impulse that keeps it from approaching. A contact sticking at the
+        // start of the step stays stuck while that needs |dP_t| ≤ μ_s dP_n, a
+        // sliding one sticks when |dP_t| ≤ μ dP_n stops its slip; otherwise
+        // |dP_t| = μ dP_n against the slip.
+        let mut sweeping = false;
         for i in 0..n {
             self.tangent_step[i] = 0.0;
+            self.held_step[i] = 0.0;
             let row = &self.rows[i];
-            self.stuck_at_start[i] = self.state[i].sticking;
-            frictional |= self.increment[i] > 0.0
-                && row.w_tt > 0.0
-                && (row.friction > 0.0 || row.stick_friction > 0.0);
+            let s = &self.state[i];
+            self.stuck_at_start[i] = s.sticking;
+            sweeping |= row.movable
+                && (s.held
+                    || (self.increment[i] > 0.0
+                        && row.w_tt > 0.0
+                        && (row.friction > 0.0 || row.stick_friction > 0.0)));
         }
-        if frictional {
+        if sweeping {
             let settled = FRICTION_SETTLED * self.scales.velocity;
             for _sweep in 0..FRICTION_SWEEPS {
                 let mut largest_change: f64 = 0.0;
                 for i in 0..n {
-                    let inc = self.increment[i];
                     let row = &self.rows[i];
+                    if !row.movable {
+                        continue;
+                    }
+                    if self.state[i].held {
+                        let rate = Self::normal_rate(row, &self.velocity);
+                        let wanted = (self.held_step[i] - rate / row.w_nn).max(0.0);
+                        let change = wanted - self.held_step[i];
+                        if change != 0.0 {
+                            self.held_step[i] = wanted;
+                            Self::apply(
+                                row,
+                                row.normal_axis(),
+                                change,
+                                &self.inv_mass,
+                                &self.inv_inertia,
+                                &mut self.velocity,
+                            );
+                            largest_change = largest_change.max(change.abs() * row.w_nn);
+                        }
+                    }
+                    let inc = self.increment[i] + self.held_step[i];
                     if inc <= 0.0
                         || row.w_tt <= 0.0
                         || (row.friction == 0.0 && row.stick_friction == 0.0)
@@ -776,7 +808,9 @@ impl ImpactSolver {
                 }
             }
             for i in 0..n {
-                self.state[i].tangent_impulse += self.tangent_step[i];
+                let s = &mut self.state[i];
+                s.tangent_impulse += self.tangent_step[i];
+                s.normal_impulse += self.held_step[i];
             }
         }
 
@@ -789,11 +823,34 @@ impl ImpactSolver {
                 continue;
             }
             let end = Self::normal_rate(row, &self.velocity);
-            self.rate_change[i] = end;
             let inc = self.increment[i];
             if inc > 0.0 {
                 let mid = 0.5 * (self.rate[i] + end);
                 let s = &mut self.state[i];
+                // In expansion the impulse's work comes out of the stored
+                // energy, e² E at most. Friction coupled into the normal can
+                // open a contact after the landing test: cut the increment
+                // back to what the energy pays for, so none is created.
+                let payable = row.restitution * row.restitution * s.energy;
+                if mid > threshold && mid * inc > payable {
+                    let keep = payable / mid;
+                    Self::apply(
+                        row,
+                        row.normal_axis(),
+                        keep - inc,
+                        &self.inv_mass,
+                        &self.inv_inertia,
+                        &mut self.velocity,
+                    );
+                    self.increment[i] = keep;
+                    s.energy = 0.0;
+                    s.normal_impulse += keep;
+                    if i == primary {
+                        primary_energy_raw = 0.0;
+                    }
+                    self.rate_change[i] = Self::normal_rate(row, &self.velocity);
+                    continue;
+                }
                 s.normal_impulse += inc;
                 if mid <= threshold {
                     // compression (or the neutral rounding band)
@@ -809,6 +866,7 @@ impl ImpactSolver {
                 s.energy = s.energy.max(0.0);
                 s.peak_energy = s.peak_energy.max(s.energy);
             }
+            self.rate_change[i] = end;
         }
 
         // Impact time of the step, dt = ∫ dP_p / F_p(E_p), with E_p linear in
@@ -834,7 +892,15 @@ impl ImpactSolver {
         // Gaps of the contacts that carry no energy.
         for i in 0..n {
             let s = &mut self.state[i];
-            if self.rows[i].movable && self.increment[i] == 0.0 && s.energy == 0.0 && dt.is_finite()
+            if s.held && self.held_step[i] == 0.0 && self.rate_change[i] > threshold {
+                // nothing holds it any more and it separates
+                s.held = false;
+            }
+            if self.rows[i].movable
+                && !s.held
+                && self.increment[i] == 0.0
+                && s.energy == 0.0
+                && dt.is_finite()
             {
                 let mid = 0.5 * (self.rate[i] + self.rate_change[i]);
                 s.gap += mid * dt;

@@ -127,6 +127,16 @@ fn push(row: &Row, axis: Axis, f: f64, inv_mass: &[f64], inv_inertia: &[f64], ac
     acc[3 * b + 2] += f * axis.arm_b * inv_inertia[b];
 }
 
+/// Friction mode of a contact that becomes loaded with slip `rt`.
+#[inline]
+fn friction_mode(rt: f64, threshold: f64) -> Tangent {
+    if rt.abs() <= threshold {
+        Tangent::Stick
+    } else {
+        Tangent::Slide(rt.signum())
+    }
+}
+
 #[inline]
 fn has_friction(row: &Row) -> bool {
     row.w_tt > 0.0 && (row.friction > 0.0 || row.stick_friction > 0.0)
@@ -165,7 +175,10 @@ impl ImpactSolver {
                 match self.timeline_free_flight(threshold) {
                     Some((contact, dt)) => {
                         t += dt;
+                        let row = &self.rows[contact];
+                        let rt = rate(row, row.tangent_axis(), &self.timeline.y);
                         self.timeline.normal[contact] = Normal::Compression;
+                        self.timeline.tangent[contact] = friction_mode(rt, threshold);
                         continue;
                     }
                     None => break,
@@ -278,11 +291,7 @@ impl ImpactSolver {
             } else {
                 Normal::Open
             });
-            tl.tangent.push(if rt.abs() <= threshold {
-                Tangent::Stick
-            } else {
-                Tangent::Slide(rt.signum())
-            });
+            tl.tangent.push(friction_mode(rt, threshold));
         }
     }
 
@@ -530,7 +539,11 @@ impl ImpactSolver {
                     Normal::Open
                 };
             }
-            Normal::Open if tl.y[w_at + i] >= 0.0 => tl.normal[i] = Normal::Compression,
+            Normal::Open if tl.y[w_at + i] >= 0.0 => {
+                tl.normal[i] = Normal::Compression;
+                let rt = rate(&row, row.tangent_axis(), &tl.y);
+                tl.tangent[i] = friction_mode(rt, threshold);
+            }
             _ => {}
         }
         if normal == tl.normal[i] {
