@@ -830,27 +830,26 @@ impl ImpactSolver {
                 // In expansion the impulse's work comes out of the stored
                 // energy, e² E at most. Friction coupled into the normal can
                 // open a contact after the landing test: cut the increment
-                // back to what the energy pays for, so none is created.
+                // just enough that the mid-step rate is what the energy pays
+                // for (zero for e = 0); the contact leaves the step opening.
                 let payable = row.restitution * row.restitution * s.energy;
-                if mid > threshold && mid * inc > payable {
-                    let keep = payable / mid;
+                let (inc, mid) = if mid > threshold && mid * inc > payable {
+                    let target = payable / inc;
+                    let cut = (2.0 * (mid - target) / row.w_nn).clamp(0.0, inc);
                     Self::apply(
                         row,
                         row.normal_axis(),
-                        keep - inc,
+                        -cut,
                         &self.inv_mass,
                         &self.inv_inertia,
                         &mut self.velocity,
                     );
-                    self.increment[i] = keep;
-                    s.energy = 0.0;
-                    s.normal_impulse += keep;
-                    if i == primary {
-                        primary_energy_raw = 0.0;
-                    }
-                    self.rate_change[i] = Self::normal_rate(row, &self.velocity);
-                    continue;
-                }
+                    self.increment[i] = inc - cut;
+                    let end = Self::normal_rate(row, &self.velocity);
+                    (inc - cut, 0.5 * (self.rate[i] + end))
+                } else {
+                    (inc, mid)
+                };
                 s.normal_impulse += inc;
                 if mid <= threshold {
                     // compression (or the neutral rounding band)
@@ -866,7 +865,7 @@ impl ImpactSolver {
                 s.energy = s.energy.max(0.0);
                 s.peak_energy = s.peak_energy.max(s.energy);
             }
-            self.rate_change[i] = end;
+            self.rate_change[i] = Self::normal_rate(row, &self.velocity);
         }
 
         // Impact time of the step, dt = ∫ dP_p / F_p(E_p), with E_p linear in
