@@ -88,3 +88,60 @@ fn domino_group_dissipates_and_both_step_controls_agree() {
         assert!(c.normal_impulse >= 0.0);
     }
 }
+
+/// A standing Domino X block on nine λ points (e2 = 0.5, friction) struck at
+/// its top by the falling block (e1 = 0.85), dumped from a Rapier scene: the
+/// impact must end well within the step limit, without creating energy, and
+/// the struck block must come away rotating forward (clockwise).
+#[test]
+fn domino_first_hit_ends_and_dissipates() {
+    let text = include_str!("data/domino-x-first-hit.json");
+    let input: serde_json::Value = serde_json::from_str(text).unwrap();
+    let bodies: Vec<topple::impact::Body> = input["bodies"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|b| serde_json::from_value(b.clone()).unwrap())
+        .collect();
+    let contacts: Vec<topple::impact::Contact> = input["contacts"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|c| {
+            let m = ContactMaterial {
+                stiffness: c["stiffness"].as_f64().unwrap(),
+                exponent: c["exponent"].as_f64().unwrap(),
+                restitution: c["restitution"].as_f64().unwrap(),
+                friction: c["friction"].as_f64().unwrap(),
+                stick_friction: c["stick_friction"].as_f64().unwrap(),
+            };
+            let side = |k: usize| c["bodies"][k].as_u64().map(|i| i as usize);
+            let v = |key: &str, k: usize| c[key][k].as_f64().unwrap();
+            topple::impact::Contact::new(
+                [side(0), side(1)],
+                [v("point", 0), v("point", 1)],
+                [v("normal", 0), v("normal", 1)],
+                m,
+            )
+        })
+        .collect();
+    for settings in [
+        ImpactSettings {
+            max_steps: 200_000,
+            ..ImpactSettings::default()
+        },
+        ImpactSettings {
+            max_steps: 200_000,
+            ..ImpactSettings::adaptive(1e-8)
+        },
+    ] {
+        let out = ImpactSolver::new()
+            .solve(&bodies, &contacts, &settings)
+            .unwrap();
+        assert!(out.kinetic_energy_after < out.kinetic_energy_before);
+        assert!(
+            out.bodies[0].angular_velocity < 0.0,
+            "struck block turns forward"
+        );
+    }
+}

@@ -832,8 +832,10 @@ impl ImpactSolver {
                 // open a contact after the landing test: cut the increment
                 // just enough that the mid-step rate is what the energy pays
                 // for (zero for e = 0); the contact leaves the step opening.
+                // The contact has then spent its energy (what is left of it is
+                // dissipated, never created).
                 let payable = row.restitution * row.restitution * s.energy;
-                let (inc, mid) = if mid > threshold && mid * inc > payable {
+                if mid > threshold && mid * inc > payable {
                     let target = payable / inc;
                     let cut = (2.0 * (mid - target) / row.w_nn).clamp(0.0, inc);
                     Self::apply(
@@ -845,11 +847,14 @@ impl ImpactSolver {
                         &mut self.velocity,
                     );
                     self.increment[i] = inc - cut;
-                    let end = Self::normal_rate(row, &self.velocity);
-                    (inc - cut, 0.5 * (self.rate[i] + end))
-                } else {
-                    (inc, mid)
-                };
+                    s.normal_impulse += inc - cut;
+                    s.energy = 0.0;
+                    if i == primary {
+                        primary_energy_raw = 0.0;
+                    }
+                    self.rate_change[i] = Self::normal_rate(row, &self.velocity);
+                    continue;
+                }
                 s.normal_impulse += inc;
                 if mid <= threshold {
                     // compression (or the neutral rounding band)
