@@ -15,8 +15,8 @@
 //!
 //! Data flows down the table: a module uses the ones above it, never one below.
 
-pub mod impact;
 pub mod domino;
-pub mod theory;
-pub mod reference;
+pub mod impact;
 pub mod rapier;
+pub mod reference;
+pub mod theory;

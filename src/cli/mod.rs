@@ -4,10 +4,15 @@
 
 use clap::{Parser, Subcommand};
 
+mod chain;
 mod impact;
 
 #[derive(Parser)]
-#[command(name = "topple", version, about = "LZB multiple impacts for dominoes, Rapier and Bevy")]
+#[command(
+    name = "topple",
+    version,
+    about = "LZB multiple impacts for dominoes, Rapier and Bevy"
+)]
 struct Cli {
     #[command(subcommand)]
     command: Command,
@@ -17,6 +22,8 @@ struct Cli {
 enum Command {
     /// Resolve one multiple impact given as JSON (FILE, or - for stdin).
     Impact(impact::Args),
+    /// Simulate a row of dominoes (the paper's model) and report the wave.
+    Chain(chain::Args),
 }
 
 /// Parses the command line, runs the subcommand, returns the exit status.
@@ -24,6 +31,7 @@ pub fn run() -> i32 {
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Impact(args) => impact::run(args),
+        Command::Chain(args) => chain::run(args),
     };
     match result {
         Ok(()) => 0,

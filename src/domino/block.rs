@@ -81,7 +81,12 @@ impl Block {
     /// top, back top, back bottom.
     pub fn world_corners(&self, centre: [f64; 2], angle: f64) -> [[f64; 2]; 4] {
         let (s, c) = angle.sin_cos();
-        let w = |p: [f64; 2]| [centre[0] + c * p[0] - s * p[1], centre[1] + s * p[0] + c * p[1]];
+        let w = |p: [f64; 2]| {
+            [
+                centre[0] + c * p[0] - s * p[1],
+                centre[1] + s * p[0] + c * p[1],
+            ]
+        };
         [
             w(self.front_bottom()),
             w(self.front_top()),

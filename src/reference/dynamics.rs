@@ -61,7 +61,8 @@ impl View<'_> {
     }
     #[inline]
     pub fn local(&self, j: Option<usize>) -> Option<usize> {
-        j.filter(|&j| j >= self.lo && j < self.hi).map(|j| j - self.lo)
+        j.filter(|&j| j >= self.lo && j < self.hi)
+            .map(|j| j - self.lo)
     }
 }
 
@@ -293,7 +294,10 @@ impl Dynamics {
             self.ft.push(ft);
             let k = &self.kins[c];
             self.power += fnn * k.gdot + ft * k.vt;
-            let bodies = [view.local(Some(self.geoms[c].corner)), view.local(self.geoms[c].face)];
+            let bodies = [
+                view.local(Some(self.geoms[c].corner)),
+                view.local(self.geoms[c].face),
+            ];
             for (b, body) in bodies.iter().enumerate() {
                 if let Some(b_) = body {
                     let f = [
@@ -328,7 +332,15 @@ impl Dynamics {
     /// positions so that every gap is 0, then velocities so that δ̇ = 0 and, for
     /// sticking contacts, v_t = 0 (one Gauss–Newton step with the metric M, so
     /// the change is the smallest in kinetic-energy norm). Works on `y` in place.
-    pub fn project(&mut self, rc: &RowConst, lo: usize, hi: usize, y: &mut [f64], pos: &[[f64; 3]], active: &[Active]) {
+    pub fn project(
+        &mut self,
+        rc: &RowConst,
+        lo: usize,
+        hi: usize,
+        y: &mut [f64],
+        pos: &[[f64; 3]],
+        active: &[Active],
+    ) {
         if active.is_empty() {
             return;
         }

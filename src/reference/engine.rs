@@ -198,8 +198,8 @@ impl Engine {
             h_adapt: 1e-4,
         };
         e.hit[0] = Some(0.0);
-        e.energy.initial = e.total_energy();
         e.sync_in();
+        e.energy.initial = e.total_energy();
         Ok(e)
     }
 
@@ -345,12 +345,7 @@ impl Engine {
             y: y1,
             pos: &self.pos,
         };
-        let mut deepest = self
-            .dynamics
-            .gap
-            .iter()
-            .cloned()
-            .fold(0.0f64, f64::min);
+        let mut deepest = self.dynamics.gap.iter().cloned().fold(0.0f64, f64::min);
         let k = self.k_slots;
         let rc = &self.rc;
         let is_active = &self.is_active;
@@ -603,10 +598,12 @@ impl Engine {
         let pos = &self.pos;
         let active = &self.active;
         let mut evals = 0;
-        let ok = self.stages.step(tab, h, &self.y, &self.k0, &mut self.y1, |y, dy| {
-            evals += 1;
-            rhs(dynamics, rc, lo, hi, pos, active, y, dy)
-        });
+        let ok = self
+            .stages
+            .step(tab, h, &self.y, &self.k0, &mut self.y1, |y, dy| {
+                evals += 1;
+                rhs(dynamics, rc, lo, hi, pos, active, y, dy)
+            });
         self.evaluations += evals;
         ok
     }
@@ -733,12 +730,15 @@ pub fn run(row: &RowSpec, settings: &Settings) -> Result<RunResult, EngineError>
     e.energy.kinetic = k;
     e.energy.potential = u;
     let en = &mut e.energy;
-    en.residual =
-        en.initial - (en.kinetic + en.potential + en.impacts + en.friction + en.projection + en.frozen);
+    en.residual = en.initial
+        - (en.kinetic + en.potential + en.impacts + en.friction + en.projection + en.frozen);
     report.energy = Some(e.energy);
     report.max_penetration = Some(e.max_penetration);
     report.impacts = e.impacts;
-    report.reversed_blocks = (0..row.n).filter(|&i| e.reversed[i]).map(|i| i + 1).collect();
+    report.reversed_blocks = (0..row.n)
+        .filter(|&i| e.reversed[i])
+        .map(|i| i + 1)
+        .collect();
     report.simulated_time = e.t;
     report.run_time = start.elapsed().as_secs_f64();
     report.series = std::mem::take(&mut e.series);

@@ -155,11 +155,7 @@ pub(crate) fn geom(
 
 /// Velocity terms of a candidate. `q(j)`, `v(j)` give block j's configuration
 /// and velocity (vx, vy, ω); a fixed (frozen) block has v = 0.
-pub(crate) fn kin(
-    g: &Geom,
-    q: impl Fn(usize) -> [f64; 3],
-    v: impl Fn(usize) -> [f64; 3],
-) -> Kin {
+pub(crate) fn kin(g: &Geom, q: impl Fn(usize) -> [f64; 3], v: impl Fn(usize) -> [f64; 3]) -> Kin {
     let n = g.normal;
     let t = perp(n);
     let qa = q(g.corner);
@@ -186,14 +182,8 @@ pub(crate) fn kin(
     let un = dot(n, u);
     let ut = dot(t, u);
     Kin {
-        jn: [
-            [n[0], n[1], cross(ra, n)],
-            [-n[0], -n[1], -cross(rb, n)],
-        ],
-        jt: [
-            [t[0], t[1], cross(ra, t)],
-            [-t[0], -t[1], -cross(rb, t)],
-        ],
+        jn: [[n[0], n[1], cross(ra, n)], [-n[0], -n[1], -cross(rb, n)]],
+        jt: [[t[0], t[1], cross(ra, t)], [-t[0], -t[1], -cross(rb, t)]],
         gdot: un,
         vt: ut,
         sn: wb * ut + dot(n, w),
