@@ -6,6 +6,8 @@ use clap::{Parser, Subcommand};
 
 mod chain;
 mod impact;
+mod paper;
+mod plot;
 
 #[derive(Parser)]
 #[command(
@@ -24,6 +26,8 @@ enum Command {
     Impact(impact::Args),
     /// Simulate a row of dominoes (the paper's model) and report the wave.
     Chain(chain::Args),
+    /// Regenerate the paper's Figs. 3–10 (CSV + SVG) with the reference engine.
+    Paper(paper::Args),
 }
 
 /// Parses the command line, runs the subcommand, returns the exit status.
@@ -32,6 +36,7 @@ pub fn run() -> i32 {
     let result = match cli.command {
         Command::Impact(args) => impact::run(args),
         Command::Chain(args) => chain::run(args),
+        Command::Paper(args) => paper::run_cmd(args),
     };
     match result {
         Ok(()) => 0,

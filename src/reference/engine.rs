@@ -318,22 +318,26 @@ impl Engine {
     /// forces at `y1`). Also tracks the deepest penetration.
     fn events_at(&mut self, y1: &[f64]) -> bool {
         let mut event = false;
+        let dbg = std::env::var_os("TOPPLE_DEBUG3").is_some() && self.steps > 20000;
         for (c, a) in self.active.iter().enumerate() {
             let (_, mus) = self.rc.mu(a.slot);
             let d = &self.dynamics;
             let fnn = d.fn_[c];
             if !d.valid[c] || fnn < self.ref_fn[c] - self.tol.force {
                 event = true;
+                if dbg { eprintln!("ev lift {:?} fn {} ref {} valid {}", a, fnn, self.ref_fn[c], d.valid[c]); }
             }
             match a.mode {
                 Mode::Stick => {
                     if d.ft[c].abs() - mus * fnn > self.ref_stick[c] + self.tol.force {
                         event = true;
+                        if dbg { eprintln!("ev stick {:?} ft {} fn {} ref {}", a, d.ft[c], fnn, self.ref_stick[c]); }
                     }
                 }
                 Mode::Slide(dir) => {
                     if dir * d.vt[c] < self.ref_slide[c] - 0.5 * self.v_tol {
                         event = true;
+                        if dbg { eprintln!("ev slide {:?} vt {} ref {}", a, d.vt[c], self.ref_slide[c]); }
                     }
                 }
                 Mode::Frictionless => {}
@@ -350,6 +354,7 @@ impl Engine {
         let rc = &self.rc;
         let is_active = &self.is_active;
         let eps = self.eps_gap;
+        let vtol = self.v_tol;
         self.for_each_slot(|i, slot| {
             if is_active[i * k + slot] || event {
                 return;
@@ -365,8 +370,9 @@ impl Engine {
                 return;
             }
             let kk = rc.kin(&view, &g);
-            if kk.gdot < 0.0 {
+            if kk.gdot < -vtol {
                 event = true;
+                if dbg { eprintln!("ev gap {} {} gap {} gdot {}", i, slot, g.gap, kk.gdot); }
             }
         });
         self.max_penetration = self.max_penetration.max(-deepest);
@@ -686,6 +692,9 @@ impl Engine {
         std::mem::swap(&mut self.y, &mut self.y1);
         self.t += h;
         self.steps += 1;
+        if std::env::var_os("TOPPLE_DEBUG2").is_some() && self.steps % 2000 == 0 {
+            eprintln!("step {} t {:.6} h {:.3e} window {}..{} active {} impacts {} evals {} event {}", self.steps, self.t, h, self.lo, self.hi, self.active.len(), self.impacts, self.evaluations, event);
+        }
         let last = self.y.len() - 1;
         self.energy.friction += self.y[last];
         self.y[last] = 0.0;

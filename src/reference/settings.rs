@@ -71,7 +71,7 @@ impl Default for Settings {
             integrator: Integrator::default(),
             impact: ImpactSettings::default(),
             gap_tolerance: 1e-6,
-            velocity_tolerance: 1e-4,
+            velocity_tolerance: 1e-2,
             freeze_tolerance: 1e-4,
             event_time_tolerance: 1e-10,
             t_max: None,
