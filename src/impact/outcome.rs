@@ -35,6 +35,9 @@ pub struct ImpactOutcome {
     pub kinetic_energy_before: f64,
     /// Kinetic energy of all bodies after the impact (J).
     pub kinetic_energy_after: f64,
+    /// Duration of the impact (s) under the contact law F = k δ^α: the
+    /// resolver tracks time as dt = dP_p / F_p to follow micro-gaps.
+    pub duration: f64,
     /// Impulse steps taken (accepted steps in adaptive mode).
     pub steps: usize,
     /// Steps rejected by the adaptive error control.
