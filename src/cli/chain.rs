@@ -86,6 +86,9 @@ pub struct Args {
     /// Exponent of the contact law.
     #[arg(long)]
     pub alpha: Option<f64>,
+    /// Factor on the friction coefficients inside impacts (0.5 in the paper).
+    #[arg(long)]
+    pub impact_friction_factor: Option<f64>,
     /// Block height h (m).
     #[arg(long)]
     pub height: Option<f64>,
@@ -102,6 +105,10 @@ pub struct Args {
     /// Fixed time step of the paper's integration (s).
     #[arg(long, default_value_t = 1e-4)]
     pub dt: f64,
+    /// Freeze blocks behind the wave below this speed (fraction of √(gh)) and
+    /// acceleration (fraction of g); 0 never freezes.
+    #[arg(long)]
+    pub freeze_tolerance: Option<f64>,
     /// Print the report as JSON.
     #[arg(long)]
     pub json: bool,
@@ -157,6 +164,9 @@ pub fn params(args: &Args) -> RowParams {
     if let Some(v) = args.lambda {
         p.lambda_points = v;
     }
+    if let Some(v) = args.impact_friction_factor {
+        p.impact_friction_factor = v;
+    }
     if let Some(v) = args.alpha {
         p.alpha = v;
     }
@@ -173,6 +183,9 @@ pub fn run(args: Args) -> anyhow::Result<()> {
             ..Default::default()
         },
     };
+    if let Some(f) = args.freeze_tolerance {
+        settings.freeze_tolerance = f;
+    }
     settings.series_blocks = args.series.clone();
     settings.snapshot_times = args.snapshots.clone();
     let out = match args.engine {
@@ -212,8 +225,9 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         );
     }
     println!(
-        "impacts {}, max penetration {:.3e} m, blocks turning back: {:?}, simulated {:.4} s in {:.3} s ({} steps)",
+        "impacts {} ({} plastic fallbacks), max penetration {:.3e} m, blocks turning back: {:?}, simulated {:.4} s in {:.3} s ({} steps)",
         r.impacts,
+        r.impact_fallbacks,
         r.max_penetration.unwrap_or(0.0),
         r.reversed_blocks,
         r.simulated_time,

@@ -63,7 +63,8 @@ fn natural(r: &ChainReport) -> f64 {
 }
 
 pub fn run_cmd(args: Args) -> anyhow::Result<()> {
-    std::fs::create_dir_all(&args.out).with_context(|| format!("creating {}", args.out.display()))?;
+    std::fs::create_dir_all(&args.out)
+        .with_context(|| format!("creating {}", args.out.display()))?;
     let want = |f: u32| args.figs.is_empty() || args.figs.contains(&f);
     let base = match args.tolerance {
         Some(t) => Settings::accurate(t),
@@ -77,7 +78,14 @@ pub fn run_cmd(args: Args) -> anyhow::Result<()> {
     let x = Preset::X.params();
     let spacings: Vec<f64> = (0..11).map(|k| 0.1 + 0.05 * k as f64).collect();
     let three = [0.18, 0.35, 0.52];
-    let mk = |fig: u32, key: String, xv: f64, p: RowParams, sh: f64, push: f64, n: usize, s: &Settings| Job {
+    let mk = |fig: u32,
+              key: String,
+              xv: f64,
+              p: RowParams,
+              sh: f64,
+              push: f64,
+              n: usize,
+              s: &Settings| Job {
         fig,
         key,
         x: xv,
@@ -99,8 +107,26 @@ pub fn run_cmd(args: Args) -> anyhow::Result<()> {
     if want(5) {
         let t = Preset::T.params();
         for &sh in &spacings {
-            jobs.push(mk(5, "mu1 = 0, e1 = 0".into(), sh, t.ideal(), sh, 1.0, n, &base));
-            jobs.push(mk(5, "mu1 = 0.15, e1 = 0".into(), sh, set_mu1(t.ideal(), 0.15), sh, 1.0, n, &base));
+            jobs.push(mk(
+                5,
+                "mu1 = 0, e1 = 0".into(),
+                sh,
+                t.ideal(),
+                sh,
+                1.0,
+                n,
+                &base,
+            ));
+            jobs.push(mk(
+                5,
+                "mu1 = 0.15, e1 = 0".into(),
+                sh,
+                set_mu1(t.ideal(), 0.15),
+                sh,
+                1.0,
+                n,
+                &base,
+            ));
         }
     }
     if want(6) || want(7) {
@@ -109,12 +135,39 @@ pub fn run_cmd(args: Args) -> anyhow::Result<()> {
             ..base.clone()
         };
         jobs.push(mk(7, "Table 1".into(), 0.0, x, 0.52, 1.0, 20, &series));
-        jobs.push(mk(7, "ideal".into(), 0.0, x.ideal(), 0.52, 1.0, 20, &series));
+        jobs.push(mk(
+            7,
+            "ideal".into(),
+            0.0,
+            x.ideal(),
+            0.52,
+            1.0,
+            20,
+            &series,
+        ));
     }
     if want(8) {
         for push in [0.5, 1.0, 1.8] {
-            jobs.push(mk(8, format!("Table 1, push {push}"), 0.0, x, 0.52, push, n, &base));
-            jobs.push(mk(8, format!("ideal, push {push}"), 0.0, x.ideal(), 0.52, push, n, &base));
+            jobs.push(mk(
+                8,
+                format!("Table 1, push {push}"),
+                0.0,
+                x,
+                0.52,
+                push,
+                n,
+                &base,
+            ));
+            jobs.push(mk(
+                8,
+                format!("ideal, push {push}"),
+                0.0,
+                x.ideal(),
+                0.52,
+                push,
+                n,
+                &base,
+            ));
         }
     }
     if want(9) {
@@ -192,7 +245,12 @@ pub fn run_cmd(args: Args) -> anyhow::Result<()> {
         let mut rows = Vec::new();
         let mut curves = Vec::new();
         for (j, r) in &v {
-            let pts: Vec<(f64, f64)> = r.speeds.iter().enumerate().map(|(i, s)| ((i + 1) as f64, *s)).collect();
+            let pts: Vec<(f64, f64)> = r
+                .speeds
+                .iter()
+                .enumerate()
+                .map(|(i, s)| ((i + 1) as f64, *s))
+                .collect();
             for (i, s) in &pts {
                 rows.push(vec![j.row.push, *i, *s]);
             }
@@ -202,8 +260,18 @@ pub fn run_cmd(args: Args) -> anyhow::Result<()> {
                 markers: true,
             });
         }
-        csv(&out.join(format!("fig{fig}.csv")), "push,block,v_hat", &rows)?;
-        plot(&out.join(format!("fig{fig}.svg")), title, "block n", "v̂", &curves)
+        csv(
+            &out.join(format!("fig{fig}.csv")),
+            "push,block,v_hat",
+            &rows,
+        )?;
+        plot(
+            &out.join(format!("fig{fig}.svg")),
+            title,
+            "block n",
+            "v̂",
+            &curves,
+        )
     };
     if want(3) {
         along(3, "Fig. 3: Domino X, Table 1, s/h = 0.18")?;
@@ -220,7 +288,11 @@ pub fn run_cmd(args: Args) -> anyhow::Result<()> {
         let mut rows = Vec::new();
         let mut curves = Vec::new();
         for (ki, k) in keys(&v).iter().enumerate() {
-            let pts: Vec<(f64, f64)> = v.iter().filter(|(j, _)| &j.key == k).map(|(j, r)| (j.x, natural(r))).collect();
+            let pts: Vec<(f64, f64)> = v
+                .iter()
+                .filter(|(j, _)| &j.key == k)
+                .map(|(j, r)| (j.x, natural(r)))
+                .collect();
             for (xv, yv) in &pts {
                 let spread = v
                     .iter()
@@ -280,7 +352,11 @@ pub fn run_cmd(args: Args) -> anyhow::Result<()> {
                 });
             }
             let tag = if j.key == "ideal" { "b" } else { "a" };
-            csv(&out.join(format!("fig7{tag}.csv")), "block,t_over_tbar,theta_dot_hat", &rows)?;
+            csv(
+                &out.join(format!("fig7{tag}.csv")),
+                "block,t_over_tbar,theta_dot_hat",
+                &rows,
+            )?;
             if want(7) {
                 plot(
                     &out.join(format!("fig7{tag}.svg")),

@@ -25,9 +25,23 @@ const COLOURS: [RGBColor; 6] = [
 ];
 
 /// Writes an SVG plot of the curves.
-pub fn plot(path: &Path, title: &str, xlabel: &str, ylabel: &str, curves: &[Curve]) -> anyhow::Result<()> {
-    let pts = curves.iter().flat_map(|c| c.points.iter()).filter(|p| p.0.is_finite() && p.1.is_finite());
-    let (mut x0, mut x1, mut y0, mut y1) = (f64::INFINITY, f64::NEG_INFINITY, f64::INFINITY, f64::NEG_INFINITY);
+pub fn plot(
+    path: &Path,
+    title: &str,
+    xlabel: &str,
+    ylabel: &str,
+    curves: &[Curve],
+) -> anyhow::Result<()> {
+    let pts = curves
+        .iter()
+        .flat_map(|c| c.points.iter())
+        .filter(|p| p.0.is_finite() && p.1.is_finite());
+    let (mut x0, mut x1, mut y0, mut y1) = (
+        f64::INFINITY,
+        f64::NEG_INFINITY,
+        f64::INFINITY,
+        f64::NEG_INFINITY,
+    );
     for &(x, y) in pts {
         x0 = x0.min(x);
         x1 = x1.max(x);
@@ -56,7 +70,12 @@ pub fn plot(path: &Path, title: &str, xlabel: &str, ylabel: &str, curves: &[Curv
         .map_err(|e| anyhow::anyhow!("{e}"))?;
     for (k, c) in curves.iter().enumerate() {
         let col = COLOURS[k % COLOURS.len()];
-        let pts: Vec<(f64, f64)> = c.points.iter().cloned().filter(|p| p.0.is_finite() && p.1.is_finite()).collect();
+        let pts: Vec<(f64, f64)> = c
+            .points
+            .iter()
+            .cloned()
+            .filter(|p| p.0.is_finite() && p.1.is_finite())
+            .collect();
         if c.markers {
             chart
                 .draw_series(pts.iter().map(|&p| Circle::new(p, 3, col.filled())))
@@ -68,7 +87,9 @@ pub fn plot(path: &Path, title: &str, xlabel: &str, ylabel: &str, curves: &[Curv
                 .draw_series(LineSeries::new(pts, col.stroke_width(2)))
                 .map_err(|e| anyhow::anyhow!("{e}"))?
                 .label(c.name.clone())
-                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], col.stroke_width(2)));
+                .legend(move |(x, y)| {
+                    PathElement::new(vec![(x, y), (x + 20, y)], col.stroke_width(2))
+                });
         }
     }
     chart

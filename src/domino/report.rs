@@ -78,6 +78,9 @@ pub struct ChainReport {
     pub max_penetration: Option<f64>,
     /// Number of impacts resolved.
     pub impacts: usize,
+    /// Impacts the LZB resolver could not finish within its step limit,
+    /// resolved as plastic impacts instead (should be 0 or rare).
+    pub impact_fallbacks: usize,
     /// Blocks that rotated anticlockwise (θ̇ < 0) at some time, 1-based.
     pub reversed_blocks: Vec<usize>,
     /// Simulated time (s).
@@ -103,6 +106,7 @@ impl ChainReport {
             energy: None,
             max_penetration: None,
             impacts: 0,
+            impact_fallbacks: 0,
             reversed_blocks: Vec::new(),
             simulated_time: 0.0,
             run_time: 0.0,

@@ -329,9 +329,12 @@ impl Dynamics {
     }
 
     /// Projects the moving blocks onto the constraints of the active contacts:
-    /// positions so that every gap is 0, then velocities so that δ̇ = 0 and, for
-    /// sticking contacts, v_t = 0 (one Gauss–Newton step with the metric M, so
-    /// the change is the smallest in kinetic-energy norm). Works on `y` in place.
+    /// velocities so that δ̇ = 0 and, for sticking contacts, v_t = 0, then
+    /// positions so that every gap is 0 (one Gauss–Newton step with the metric
+    /// M, so the change is the smallest in kinetic-energy norm). The velocity
+    /// projection is unilateral: a contact that would have to be pulled
+    /// harder than a contact separating at `v_tol` (m/s) is separating; it is
+    /// removed from `active` and the projection repeated. Works on `y` in place.
     pub fn project(
         &mut self,
         rc: &RowConst,
@@ -339,58 +342,98 @@ impl Dynamics {
         hi: usize,
         y: &mut [f64],
         pos: &[[f64; 3]],
-        active: &[Active],
+        active: &mut Vec<Active>,
+        v_tol: f64,
     ) {
-        if active.is_empty() {
-            return;
-        }
+        let mut y0: Vec<f64> = Vec::new();
         for pass in 0..2 {
-            self.unknowns.clear();
-            self.band.rhs.clear();
-            {
-                let view = View { lo, hi, y, pos };
-                for a in active {
-                    let gm = rc.geom(&view, a.block, a.slot).expect("slot exists");
-                    let k = rc.kin(&view, &gm);
-                    let bodies = [view.local(Some(gm.corner)), view.local(gm.face)];
-                    if bodies.iter().all(|b| b.is_none()) {
-                        continue;
-                    }
-                    self.unknowns.push(Unknown {
-                        bodies,
-                        row: k.jn,
-                        col: k.jn,
-                    });
-                    self.band
-                        .rhs
-                        .push(if pass == 0 { -gm.gap } else { -k.gdot });
-                    if pass == 1 && a.mode == Mode::Stick {
-                        self.unknowns.push(Unknown {
-                            bodies,
-                            row: k.jt,
-                            col: k.jt,
-                        });
-                        self.band.rhs.push(-k.vt);
+            let mut rounds = 0;
+            loop {
+                rounds += 1;
+                if active.is_empty() {
+                    return;
+                }
+                if pass == 0 {
+                    if rounds == 1 {
+                        y0.clear();
+                        y0.extend_from_slice(y);
+                    } else {
+                        y.copy_from_slice(&y0);
                     }
                 }
-            }
-            if self.unknowns.is_empty() {
-                return;
-            }
-            self.assemble(rc);
-            if !self.band.solve() {
-                return;
-            }
-            let off = if pass == 0 { 0 } else { 3 };
-            for (u, mu) in self.unknowns.iter().zip(self.band.rhs.iter()) {
-                for (b, body) in u.bodies.iter().enumerate() {
-                    if let Some(b_) = body {
-                        let d = rc.minv(u.col[b]);
-                        for x in 0..3 {
-                            y[6 * b_ + off + x] += mu * d[x];
+                self.unknowns.clear();
+                self.band.rhs.clear();
+                self.kins.clear(); // owner index per unknown, reused as a tag
+                let mut owner: Vec<(usize, bool)> = Vec::new();
+                {
+                    let view = View { lo, hi, y, pos };
+                    for (c, a) in active.iter().enumerate() {
+                        let gm = rc.geom(&view, a.block, a.slot).expect("slot exists");
+                        let k = rc.kin(&view, &gm);
+                        let bodies = [view.local(Some(gm.corner)), view.local(gm.face)];
+                        if bodies.iter().all(|b| b.is_none()) {
+                            continue;
+                        }
+                        self.unknowns.push(Unknown {
+                            bodies,
+                            row: k.jn,
+                            col: k.jn,
+                        });
+                        owner.push((c, true));
+                        self.band
+                            .rhs
+                            .push(if pass == 1 { -gm.gap } else { -k.gdot });
+                        if pass == 0 && a.mode == Mode::Stick {
+                            self.unknowns.push(Unknown {
+                                bodies,
+                                row: k.jt,
+                                col: k.jt,
+                            });
+                            owner.push((c, false));
+                            self.band.rhs.push(-k.vt);
                         }
                     }
                 }
+                if self.unknowns.is_empty() {
+                    return;
+                }
+                self.assemble(rc);
+                if !self.band.solve() {
+                    return;
+                }
+                if pass == 0 && rounds < 20 {
+                    // drop the contacts that would be pulled together by more
+                    // than the impulse that closes a contact separating at the
+                    // velocity tolerance (a small pull is the persistence of a
+                    // contact that separates slower than that)
+                    let pull = 2.0 * rc.p.block.mass * v_tol;
+                    let mut drop: Vec<usize> = owner
+                        .iter()
+                        .zip(self.band.rhs.iter())
+                        .filter(|((_, normal), p)| *normal && **p < -pull)
+                        .map(|((c, _), _)| *c)
+                        .collect();
+                    if !drop.is_empty() {
+                        drop.sort_unstable();
+                        drop.dedup();
+                        for c in drop.into_iter().rev() {
+                            active.remove(c);
+                        }
+                        continue;
+                    }
+                }
+                let off = if pass == 1 { 0 } else { 3 };
+                for (u, mu) in self.unknowns.iter().zip(self.band.rhs.iter()) {
+                    for (b, body) in u.bodies.iter().enumerate() {
+                        if let Some(b_) = body {
+                            let d = rc.minv(u.col[b]);
+                            for x in 0..3 {
+                                y[6 * b_ + off + x] += mu * d[x];
+                            }
+                        }
+                    }
+                }
+                break;
             }
         }
     }

@@ -82,6 +82,7 @@ pub(crate) struct Engine {
     pub energy: EnergyReport,
     pub max_penetration: f64,
     pub impacts: usize,
+    pub impact_fallbacks: usize,
     pub reversed: Vec<bool>,
     pub steps: usize,
     pub evaluations: usize,
@@ -95,6 +96,7 @@ pub(crate) struct Engine {
     // tolerances in SI
     pub eps_gap: f64,
     pub v_tol: f64,
+    pub v_app: f64,
     pub tol: ModeTol,
     series: Vec<BlockSeries>,
     next_sample: f64,
@@ -168,6 +170,7 @@ impl Engine {
             energy: EnergyReport::default(),
             max_penetration: 0.0,
             impacts: 0,
+            impact_fallbacks: 0,
             reversed: vec![false; n],
             steps: 0,
             evaluations: 0,
@@ -179,6 +182,7 @@ impl Engine {
             new_active: Vec::new(),
             eps_gap: settings.gap_tolerance * p.block.height,
             v_tol: settings.velocity_tolerance * vbar,
+            v_app: settings.approach_tolerance * vbar,
             tol: ModeTol {
                 force: 1e-9 * m * p.gravity,
                 accel: 1e-9 * p.gravity,
@@ -275,6 +279,14 @@ impl Engine {
             }
             if i + 1 < self.row.n {
                 f(i, lambda + 1);
+            }
+            // The heel of block i+1 on the front face of block i only for the
+            // last pair, where the last block lies on the ground: inside the
+            // row the pair converges to face-to-face contact at the rest angle,
+            // where the two corner contacts are redundant and make the contact
+            // and impact problems degenerate (the paper's model has only A_i
+            // and B_i there).
+            if i + 2 == self.row.n {
                 f(i, lambda + 2);
             }
         }
@@ -325,19 +337,31 @@ impl Engine {
             let fnn = d.fn_[c];
             if !d.valid[c] || fnn < self.ref_fn[c] - self.tol.force {
                 event = true;
-                if dbg { eprintln!("ev lift {:?} fn {} ref {} valid {}", a, fnn, self.ref_fn[c], d.valid[c]); }
+                if dbg {
+                    eprintln!(
+                        "ev lift {:?} fn {} ref {} valid {}",
+                        a, fnn, self.ref_fn[c], d.valid[c]
+                    );
+                }
             }
             match a.mode {
                 Mode::Stick => {
                     if d.ft[c].abs() - mus * fnn > self.ref_stick[c] + self.tol.force {
                         event = true;
-                        if dbg { eprintln!("ev stick {:?} ft {} fn {} ref {}", a, d.ft[c], fnn, self.ref_stick[c]); }
+                        if dbg {
+                            eprintln!(
+                                "ev stick {:?} ft {} fn {} ref {}",
+                                a, d.ft[c], fnn, self.ref_stick[c]
+                            );
+                        }
                     }
                 }
                 Mode::Slide(dir) => {
                     if dir * d.vt[c] < self.ref_slide[c] - 0.5 * self.v_tol {
                         event = true;
-                        if dbg { eprintln!("ev slide {:?} vt {} ref {}", a, d.vt[c], self.ref_slide[c]); }
+                        if dbg {
+                            eprintln!("ev slide {:?} vt {} ref {}", a, d.vt[c], self.ref_slide[c]);
+                        }
                     }
                 }
                 Mode::Frictionless => {}
@@ -354,7 +378,7 @@ impl Engine {
         let rc = &self.rc;
         let is_active = &self.is_active;
         let eps = self.eps_gap;
-        let vtol = self.v_tol;
+        let vapp = self.v_app;
         self.for_each_slot(|i, slot| {
             if is_active[i * k + slot] || event {
                 return;
@@ -370,9 +394,11 @@ impl Engine {
                 return;
             }
             let kk = rc.kin(&view, &g);
-            if kk.gdot < -vtol {
+            if kk.gdot < -vapp {
                 event = true;
-                if dbg { eprintln!("ev gap {} {} gap {} gdot {}", i, slot, g.gap, kk.gdot); }
+                if dbg {
+                    eprintln!("ev gap {} {} gap {} gdot {}", i, slot, g.gap, kk.gdot);
+                }
             }
         });
         self.max_penetration = self.max_penetration.max(-deepest);
@@ -392,7 +418,7 @@ impl Engine {
     /// Impacts, contact mode, projection; then the derivative for the next step.
     fn handle_events(&mut self) -> Result<(), EngineError> {
         self.sync_out();
-        for _ in 0..100 {
+        for _ in 0..20 {
             if !self.resolve_impacts()? {
                 break;
             }
@@ -406,6 +432,7 @@ impl Engine {
             let rc = &self.rc;
             let eps = self.eps_gap;
             let vt = self.v_tol;
+            let vapp = self.v_app;
             self.for_each_slot(|i, slot| {
                 let Some(g) = rc.geom(&view, i, slot) else {
                     return;
@@ -413,11 +440,15 @@ impl Engine {
                 if !g.valid || g.gap > eps {
                     return;
                 }
-                if view.local(Some(g.corner)).is_none() && view.local(g.face).is_none() {
+                // contacts with a frozen block never press: a moving block that
+                // approaches a frozen one starts an impact, which wakes it
+                if view.local(Some(g.corner)).is_none()
+                    || (g.face.is_some() && view.local(g.face).is_none())
+                {
                     return;
                 }
                 let k = rc.kin(&view, &g);
-                if k.gdot.abs() <= vt {
+                if k.gdot >= -vapp && k.gdot <= vt {
                     cands.push(Candidate {
                         block: i,
                         slot,
@@ -433,7 +464,7 @@ impl Engine {
                 y: &self.y,
                 pos: &self.pos,
             };
-            let _ = select(
+            let ok = select(
                 &mut self.dynamics,
                 &self.rc,
                 &view,
@@ -441,6 +472,24 @@ impl Engine {
                 &mut self.mode_state,
                 &mut self.new_active,
                 &self.tol,
+            );
+            if !ok && std::env::var_os("TOPPLE_DEBUG7").is_some() {
+                eprintln!(
+                    "mode selection failed at t={} with {} candidates -> {} active",
+                    self.t,
+                    cands.len(),
+                    self.new_active.len()
+                );
+            }
+        }
+        if std::env::var_os("TOPPLE_DEBUG8").is_some() {
+            eprintln!(
+                "handle t={:.6} window {}..{} cands {} active {}",
+                self.t,
+                self.lo,
+                self.hi,
+                cands.len(),
+                self.new_active.len()
             );
         }
         self.candidates = cands;
@@ -453,9 +502,32 @@ impl Engine {
     fn project(&mut self) {
         let before = self.total_energy();
         let (lo, hi) = (self.lo, self.hi);
-        self.dynamics
-            .project(&self.rc, lo, hi, &mut self.y, &self.pos, &self.active);
+        let mut act = std::mem::take(&mut self.new_active);
+        act.clear();
+        act.extend_from_slice(&self.active);
+        let n_before = act.len();
+        self.dynamics.project(
+            &self.rc,
+            lo,
+            hi,
+            &mut self.y,
+            &self.pos,
+            &mut act,
+            self.v_tol,
+        );
+        self.new_active = act;
+        if self.new_active.len() != n_before {
+            self.set_active();
+        }
         let after = self.total_energy();
+        if std::env::var_os("TOPPLE_DEBUG5").is_some() && (before - after).abs() > 1e-4 {
+            eprintln!(
+                "proj t={:.6} dE={:.3e} active {:?}",
+                self.t,
+                before - after,
+                self.active
+            );
+        }
         self.energy.projection += before - after;
     }
 
@@ -489,16 +561,14 @@ impl Engine {
         let h = self.rc.p.block.height;
         let mut changed = false;
         let base = self.lo;
+        self.sync_out();
         while self.lo < self.hi {
-            let (_, v) = self.state(self.lo);
+            let v = self.vel[self.lo];
             let a = self.dynamics.acc[self.lo - base];
             let slow = v[0].abs() < vf && v[1].abs() < vf && (v[2] * h).abs() < vf;
             let still = a[0].abs() < af && a[1].abs() < af && (a[2] * h).abs() < af;
             if !(slow && still) {
                 break;
-            }
-            if !changed {
-                self.sync_out();
             }
             let b = &self.rc.p.block;
             self.energy.frozen +=
@@ -524,7 +594,7 @@ impl Engine {
             let keep = if a.slot <= lambda {
                 moving(a.block)
             } else {
-                moving(a.block) || moving(a.block + 1)
+                moving(a.block) && moving(a.block + 1)
             };
             if keep {
                 self.new_active.push(*a);
@@ -532,7 +602,22 @@ impl Engine {
         }
         self.set_active();
         self.sync_in();
-        self.eval_k0()
+        let r = self.eval_k0();
+        if std::env::var_os("TOPPLE_DEBUG9").is_some() {
+            eprintln!(
+                "rebuild t={} {}..{} active {:?}",
+                self.t,
+                self.lo,
+                self.hi,
+                self.active
+                    .iter()
+                    .map(|a| (a.block, a.slot))
+                    .collect::<Vec<_>>()
+            );
+            eprintln!("   fn {:?}", self.dynamics.fn_);
+            eprintln!("   acc {:?}", self.dynamics.acc);
+        }
+        r
     }
 
     fn record(&mut self) {
@@ -693,7 +778,18 @@ impl Engine {
         self.t += h;
         self.steps += 1;
         if std::env::var_os("TOPPLE_DEBUG2").is_some() && self.steps % 2000 == 0 {
-            eprintln!("step {} t {:.6} h {:.3e} window {}..{} active {} impacts {} evals {} event {}", self.steps, self.t, h, self.lo, self.hi, self.active.len(), self.impacts, self.evaluations, event);
+            eprintln!(
+                "step {} t {:.6} h {:.3e} window {}..{} active {} impacts {} evals {} event {}",
+                self.steps,
+                self.t,
+                h,
+                self.lo,
+                self.hi,
+                self.active.len(),
+                self.impacts,
+                self.evaluations,
+                event
+            );
         }
         let last = self.y.len() - 1;
         self.energy.friction += self.y[last];
@@ -730,6 +826,9 @@ pub fn run(row: &RowSpec, settings: &Settings) -> Result<RunResult, EngineError>
     e.handle_events()?;
     e.record();
     while e.lo < e.hi && e.t < t_max {
+        if settings.stop_at_last_hit && e.hit[row.n - 1].is_some() {
+            break;
+        }
         e.advance(t_max)?;
     }
     e.sync_out();
@@ -744,6 +843,7 @@ pub fn run(row: &RowSpec, settings: &Settings) -> Result<RunResult, EngineError>
     report.energy = Some(e.energy);
     report.max_penetration = Some(e.max_penetration);
     report.impacts = e.impacts;
+    report.impact_fallbacks = e.impact_fallbacks;
     report.reversed_blocks = (0..row.n)
         .filter(|&i| e.reversed[i])
         .map(|i| i + 1)

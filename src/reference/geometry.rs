@@ -15,7 +15,8 @@ use crate::domino::Block;
 /// on the ground (p = 0 the heel, p = λ−1 the front corner A); slot λ the front
 /// top corner B on the ground (a block lying on its face); slot λ+1 corner B of
 /// block i on the back face of block i+1 (the paper's B_i); slot λ+2 the heel of
-/// block i+1 on the front face of block i.
+/// block i+1 on the front face of block i (used for the last pair only, see
+/// the engine).
 pub(crate) fn slots_per_block(lambda: usize) -> usize {
     lambda + 3
 }

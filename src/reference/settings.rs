@@ -40,21 +40,29 @@ impl Default for Integrator {
 pub struct Settings {
     /// Time integration of the smooth phase.
     pub integrator: Integrator,
-    /// Impulse stepping of the impacts (default: the paper's ΔP = 10⁻⁴ P₀).
+    /// Impulse stepping of the impacts (default: the paper's ΔP = 10⁻⁴ P₀,
+    /// at most 2·10⁵ steps; an impact that needs more is resolved as plastic
+    /// and counted in [`crate::domino::ChainReport::impact_fallbacks`]).
     pub impact: ImpactSettings,
     /// A contact is closed when its gap is below this fraction of h
     /// (default 10⁻⁶); also the penetration allowed before a closing event.
     pub gap_tolerance: f64,
-    /// Normal velocities within ± this fraction of √(gh) count as persistent
-    /// contact, and tangential ones as sticking (default 10⁻⁴). A contact that
-    /// approaches faster starts an impact.
+    /// A closed contact separating slower than this fraction of √(gh) is made
+    /// persistent (its δ̇ projected to 0), and tangential velocities below it
+    /// count as sticking (default 10⁻³).
     pub velocity_tolerance: f64,
+    /// A closed contact approaching faster than this fraction of √(gh) starts
+    /// an impact (default 10⁻⁶, round-off level).
+    pub approach_tolerance: f64,
     /// A block behind the wave is frozen when its speeds are below this
     /// fraction of √(gh) and its accelerations below this fraction of g
     /// (default 10⁻⁴).
     pub freeze_tolerance: f64,
     /// Events are located to this time (s) (default 10⁻¹⁰).
     pub event_time_tolerance: f64,
+    /// Stop as soon as the last block is struck (the wave measures are then
+    /// complete); otherwise run until every block is at rest (default true).
+    pub stop_at_last_hit: bool,
     /// Stop at this time (s); default: 40 t̄ per block.
     pub t_max: Option<f64>,
     /// Blocks (1-based) whose θ and θ̇ are recorded.
@@ -69,11 +77,16 @@ impl Default for Settings {
     fn default() -> Self {
         Settings {
             integrator: Integrator::default(),
-            impact: ImpactSettings::default(),
+            impact: ImpactSettings {
+                max_steps: 200_000,
+                ..ImpactSettings::default()
+            },
             gap_tolerance: 1e-6,
-            velocity_tolerance: 1e-2,
+            velocity_tolerance: 1e-3,
+            approach_tolerance: 1e-6,
             freeze_tolerance: 1e-4,
             event_time_tolerance: 1e-10,
+            stop_at_last_hit: true,
             t_max: None,
             series_blocks: Vec::new(),
             series_interval: 0.0,
@@ -88,7 +101,10 @@ impl Settings {
     pub fn accurate(tolerance: f64) -> Self {
         Settings {
             integrator: Integrator::Adaptive { tolerance },
-            impact: ImpactSettings::adaptive(tolerance.max(1e-12)),
+            impact: ImpactSettings {
+                max_steps: 200_000,
+                ..ImpactSettings::adaptive(tolerance.max(1e-12))
+            },
             ..Default::default()
         }
     }

@@ -3,8 +3,6 @@
 //! between blocks, following reference/theory.md. Not shared with the crate's
 //! `theory` module on purpose: it is the oracle the engine is checked against.
 
-
-
 /// Natural speed v/√(gh) of the (extended, μ > 0) cooperative group model for
 /// blocks of height h, thickness d at gap s, friction μ between blocks.
 pub fn cooperative_speed(h: f64, d: f64, s: f64, mu: f64) -> f64 {
