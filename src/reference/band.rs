@@ -108,9 +108,7 @@ mod tests {
         let m = 7;
         let (kl, ku) = (2, 1);
         let entry = |r: usize, c: usize| -> f64 {
-            if c + kl < r || c > r + ku {
-                0.0
-            } else if r == c && r == 0 {
+            if c + kl < r || c > r + ku || (r == c && r == 0) {
                 0.0
             } else {
                 1.0 + ((3 * r + 5 * c) % 7) as f64 - if r == c { 0.0 } else { 4.0 }

@@ -201,24 +201,6 @@ impl Engine {
                 material: self.material(slot),
             });
         }
-        if std::env::var_os("TOPPLE_DEBUG").is_some() {
-            eprintln!(
-                "impact t={:.6} window {}..{} members {:?} approaching {:?}",
-                self.t, self.lo, self.hi, members, approaching
-            );
-            for c in &contacts {
-                eprintln!("   {:?} p={:?} n={:?}", c.bodies, c.point, c.normal);
-            }
-            for b in &bodies {
-                eprintln!("   body v={:?} w={}", b.velocity, b.angular_velocity);
-            }
-        }
-        if std::env::var_os("TOPPLE_DUMPALL").is_some() {
-            let _ = std::fs::write(
-                "/tmp/impact_dump.json",
-                serde_json::to_string_pretty(&(&bodies, &contacts)).unwrap(),
-            );
-        }
         let out = match self.solver.solve(&bodies, &contacts, &self.s.impact) {
             Ok(out) => out,
             Err(crate::impact::ImpactError::StepLimit { .. }) => {
@@ -238,14 +220,6 @@ impl Engine {
             }
         };
         self.impacts += 1;
-        if std::env::var_os("TOPPLE_DEBUG").is_some() {
-            for b in &out.bodies {
-                eprintln!("   after v={:?} w={}", b.velocity, b.angular_velocity);
-            }
-            for c in &out.contacts {
-                eprintln!("   impulse {:?}", c);
-            }
-        }
         self.energy.impacts += out.kinetic_energy_before - out.kinetic_energy_after;
         for (k, &i) in members.iter().enumerate() {
             let bv = out.bodies[k];
@@ -255,19 +229,6 @@ impl Engine {
             self.y[off + 2] = bv.angular_velocity;
         }
         self.sync_out();
-        if std::env::var_os("TOPPLE_DEBUG4").is_some() {
-            let view = self.view();
-            for &(i, slot) in &closed {
-                let g = self.rc.geom(&view, i, slot).unwrap();
-                let k = self.rc.kin(&view, &g);
-                if k.gdot.abs() > self.v_tol {
-                    eprintln!(
-                        "  t={:.6} post ({i},{slot}) gdot {:.3e} vt {:.3e}",
-                        self.t, k.gdot, k.vt
-                    );
-                }
-            }
-        }
         Ok(true)
     }
 }

@@ -96,15 +96,13 @@ impl Default for Settings {
 }
 
 impl Settings {
-    /// The accurate integration: adaptive Dormand–Prince at `tolerance`, with
-    /// the adaptive impact stepping at the same tolerance.
+    /// The accurate integration: adaptive Dormand–Prince at `tolerance` for
+    /// the smooth phase; impacts keep the paper's fixed impulse step (the
+    /// resolver's adaptive mode is not used here yet: with it some impacts of a
+    /// long leaning group exceeded the step limit).
     pub fn accurate(tolerance: f64) -> Self {
         Settings {
             integrator: Integrator::Adaptive { tolerance },
-            impact: ImpactSettings {
-                max_steps: 200_000,
-                ..ImpactSettings::adaptive(tolerance.max(1e-12))
-            },
             ..Default::default()
         }
     }

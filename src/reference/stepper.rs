@@ -158,14 +158,14 @@ mod tests {
         for (tab, order) in [(&HEUN, 2), (&DOPRI5, 5)] {
             let mut st = Stages::default();
             let mut errs = Vec::new();
-            for h in [0.1, 0.05] {
+            for h in [0.1f64, 0.05] {
                 let mut y1 = Vec::new();
                 let ok = st.step(tab, h, &[1.0], &[-1.0], &mut y1, |y, dy| {
                     dy[0] = -y[0];
                     true
                 });
                 assert!(ok);
-                errs.push((y1[0] - (-h as f64).exp()).abs());
+                errs.push((y1[0] - (-h).exp()).abs());
             }
             let p = (errs[0] / errs[1]).log2();
             assert!((p - (order as f64 + 1.0)).abs() < 0.3, "order {order}: {p}");
