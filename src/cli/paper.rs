@@ -27,6 +27,14 @@ pub struct Args {
     /// Accurate integration at this tolerance instead of the paper's.
     #[arg(long)]
     pub tolerance: Option<f64>,
+    /// Spacing ratios s/h of the sweeps of Figs. 4 and 5 (default 0.1 to 0.6
+    /// in steps of 0.05).
+    #[arg(long, value_delimiter = ',')]
+    pub spacings: Vec<f64>,
+    /// Wall-clock limit per run (s); a run that hits it keeps the blocks it
+    /// measured and is reported on stderr.
+    #[arg(long, default_value_t = 120.0)]
+    pub run_limit: f64,
 }
 
 struct Job {
@@ -66,17 +74,22 @@ pub fn run_cmd(args: Args) -> anyhow::Result<()> {
     std::fs::create_dir_all(&args.out)
         .with_context(|| format!("creating {}", args.out.display()))?;
     let want = |f: u32| args.figs.is_empty() || args.figs.contains(&f);
-    let base = match args.tolerance {
+    let mut base = match args.tolerance {
         Some(t) => Settings::accurate(t),
         None => Settings {
             integrator: Integrator::Paper { dt: 1e-4 },
             ..Default::default()
         },
     };
+    base.wall_time_limit = Some(args.run_limit);
     let n = args.n;
     let mut jobs: Vec<Job> = Vec::new();
     let x = Preset::X.params();
-    let spacings: Vec<f64> = (0..11).map(|k| 0.1 + 0.05 * k as f64).collect();
+    let spacings: Vec<f64> = if args.spacings.is_empty() {
+        (0..11).map(|k| 0.1 + 0.05 * k as f64).collect()
+    } else {
+        args.spacings.clone()
+    };
     let three = [0.18, 0.35, 0.52];
     let mk = |fig: u32,
               key: String,
@@ -217,9 +230,20 @@ pub fn run_cmd(args: Args) -> anyhow::Result<()> {
         })
         .collect();
     bar.finish();
-    for r in &results {
-        if let Err(e) = r {
-            eprintln!("warning: {e}");
+    for (j, r) in jobs.iter().zip(results.iter()) {
+        match r {
+            Err(e) => eprintln!("warning: {e}"),
+            Ok(r) if r.stopped_early || r.impact_fallbacks > 0 => eprintln!(
+                "warning: fig {} {} x={}: {}{} plastic fallbacks, {} of {} blocks reached",
+                j.fig,
+                j.key,
+                j.x,
+                if r.stopped_early { "run limit hit, " } else { "" },
+                r.impact_fallbacks,
+                r.hit_times.len(),
+                j.row.n
+            ),
+            _ => {}
         }
     }
     let out = &args.out;

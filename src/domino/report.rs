@@ -83,6 +83,8 @@ pub struct ChainReport {
     pub impact_fallbacks: usize,
     /// Blocks that rotated anticlockwise (θ̇ < 0) at some time, 1-based.
     pub reversed_blocks: Vec<usize>,
+    /// The run hit its wall-clock limit before the wave finished.
+    pub stopped_early: bool,
     /// Simulated time (s).
     pub simulated_time: f64,
     /// Wall-clock run time (s).
@@ -108,6 +110,7 @@ impl ChainReport {
             impacts: 0,
             impact_fallbacks: 0,
             reversed_blocks: Vec::new(),
+            stopped_early: false,
             simulated_time: 0.0,
             run_time: 0.0,
             series: Vec::new(),

@@ -753,9 +753,16 @@ pub fn run(row: &RowSpec, settings: &Settings) -> Result<RunResult, EngineError>
         .unwrap_or(40.0 * row.params.time_scale() * (row.n as f64 + 5.0));
     e.handle_events()?;
     e.record();
+    let mut stopped_early = false;
     while e.lo < e.hi && e.t < t_max {
         if settings.stop_at_last_hit && e.hit[row.n - 1].is_some() {
             break;
+        }
+        if let Some(limit) = settings.wall_time_limit {
+            if start.elapsed().as_secs_f64() > limit {
+                stopped_early = true;
+                break;
+            }
         }
         e.advance(t_max)?;
     }
@@ -771,6 +778,7 @@ pub fn run(row: &RowSpec, settings: &Settings) -> Result<RunResult, EngineError>
     report.energy = Some(e.energy);
     report.max_penetration = Some(e.max_penetration);
     report.impacts = e.impacts;
+    report.stopped_early = stopped_early;
     report.impact_fallbacks = e.impact_fallbacks;
     report.reversed_blocks = (0..row.n)
         .filter(|&i| e.reversed[i])

@@ -63,6 +63,9 @@ pub struct Settings {
     /// Stop as soon as the last block is struck (the wave measures are then
     /// complete); otherwise run until every block is at rest (default true).
     pub stop_at_last_hit: bool,
+    /// Stop after this much wall-clock time (s), keeping what was measured
+    /// (the report's `stopped_early` is then true); default: no limit.
+    pub wall_time_limit: Option<f64>,
     /// Stop at this time (s); default: 40 t̄ per block.
     pub t_max: Option<f64>,
     /// Blocks (1-based) whose θ and θ̇ are recorded.
@@ -87,6 +90,7 @@ impl Default for Settings {
             freeze_tolerance: 1e-4,
             event_time_tolerance: 1e-10,
             stop_at_last_hit: true,
+            wall_time_limit: None,
             t_max: None,
             series_blocks: Vec::new(),
             series_interval: 0.0,
