@@ -11,7 +11,9 @@ fn bench(c: &mut Criterion) {
     let row = RowSpec::new(p, 0.52 * p.block.height, 20, 1.0);
     let mut g = c.benchmark_group("chain_x_ideal_0.52_20_blocks");
     g.sample_size(10);
-    g.bench_function("paper", |b| b.iter(|| run(&row, &Settings::default()).unwrap()));
+    g.bench_function("paper", |b| {
+        b.iter(|| run(&row, &Settings::default()).unwrap())
+    });
     g.bench_function("accurate_1e-8", |b| {
         b.iter(|| run(&row, &Settings::accurate(1e-8)).unwrap())
     });

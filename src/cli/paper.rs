@@ -145,6 +145,7 @@ pub fn run_cmd(args: Args) -> anyhow::Result<()> {
     if want(6) || want(7) {
         let series = Settings {
             series_blocks: vec![7, 8, 9, 10],
+            series_interval: 2e-4,
             ..base.clone()
         };
         jobs.push(mk(7, "Table 1".into(), 0.0, x, 0.52, 1.0, 20, &series));
@@ -238,7 +239,11 @@ pub fn run_cmd(args: Args) -> anyhow::Result<()> {
                 j.fig,
                 j.key,
                 j.x,
-                if r.stopped_early { "run limit hit, " } else { "" },
+                if r.stopped_early {
+                    "run limit hit, "
+                } else {
+                    ""
+                },
                 r.impact_fallbacks,
                 r.hit_times.len(),
                 j.row.n

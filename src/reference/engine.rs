@@ -382,6 +382,17 @@ impl Engine {
                 event = true;
             }
         });
+        // The heel-on-front-face pairs inside the row are not contacts (see
+        // for_each_slot) but their overlap is measured, so that the reported
+        // penetration covers every corner the row can drive into a neighbour.
+        let lambda = self.rc.p.lambda_points;
+        for i in self.lo.saturating_sub(1)..self.hi.min(self.row.n.saturating_sub(2)) {
+            if let Some(g) = rc.geom(&view, i, lambda + 2) {
+                if g.valid {
+                    deepest = deepest.min(g.gap);
+                }
+            }
+        }
         self.max_penetration = self.max_penetration.max(-deepest);
         event
     }
