@@ -363,7 +363,6 @@ impl Dynamics {
                 }
                 self.unknowns.clear();
                 self.band.rhs.clear();
-                self.kins.clear(); // owner index per unknown, reused as a tag
                 let mut owner: Vec<(usize, bool)> = Vec::new();
                 {
                     let view = View { lo, hi, y, pos };

@@ -6,8 +6,9 @@
 //! ([`geometry`](self)): the λ points of the bottom face on the ground (the
 //! paper's A_i is the front one; all λ carry the line contact of a standing
 //! block, errata §5), the front top corner on the ground (a block lying on its
-//! face), the front top corner B_i on the next block's back face, and the next
-//! block's heel on the front face.
+//! face), the front top corner B_i on the next block's back face, and, for the
+//! last pair only, the last block's heel on the front face of the one behind
+//! (inside the row that pair is not a contact: a known gap, see the README).
 //!
 //! - Smooth phase (Eqs. 17–20): unilateral contacts with Coulomb friction, the
 //!   mode (pressing / lifting off, sticking with μ_s / sliding with μ) found by
@@ -19,7 +20,9 @@
 //! - Two integrators ([`Integrator`]): the paper's improved Euler at Δt = 10⁻⁴ s,
 //!   and Dormand–Prince 5(4) with error control.
 //! - Impacts (Sec. 2.3): by [`crate::impact::ImpactSolver`], one group of
-//!   closed contacts at a time, impact friction 0.5 × Table 1 (errata §4).
+//!   closed contacts at a time, impact friction 0.5 × Table 1 (errata §4); an
+//!   impact the resolver cannot finish within its step limit is resolved as a
+//!   plastic impact and counted (`impact_fallbacks`).
 //! - Only what moves is integrated: a window of blocks lo..hi; the block in
 //!   front of the wave joins when struck, blocks at rest behind it are frozen.
 //!   The cost per step depends on the window, not on the row.

@@ -15,7 +15,9 @@ pub enum Integrator {
     },
     /// Dormand–Prince 5(4) with step-size control: every accepted step keeps
     /// its local error below `tolerance` relative to the scales h (m), 1 (rad),
-    /// √(gh) (m/s) and m g h (J); events are located by bisection.
+    /// √(gh) (m/s) and m g h (J); events are located by bisection. Steps are
+    /// capped at 0.002 t̄: events are tested at step ends only, and a longer
+    /// step can step over a short excursion (e.g. a brief lift-off).
     Adaptive {
         /// Relative local error tolerance, dimensionless.
         tolerance: f64,
