@@ -214,11 +214,22 @@ impl Engine {
     }
 
     fn energies(&self) -> (f64, f64) {
+        self.energies_of(0, self.row.n)
+    }
+
+    /// Kinetic + potential energy of the moving blocks only (J): what a
+    /// projection or impact can change, in O(window).
+    pub fn window_energy(&self) -> f64 {
+        let (k, u) = self.energies_of(self.lo, self.hi);
+        k + u
+    }
+
+    fn energies_of(&self, from: usize, to: usize) -> (f64, f64) {
         let b = &self.rc.p.block;
         let g = self.rc.p.gravity;
         let mut k = 0.0;
         let mut u = 0.0;
-        for i in 0..self.row.n {
+        for i in from..to {
             let (q, v) = self.state(i);
             k += 0.5 * b.mass * (v[0] * v[0] + v[1] * v[1]) + 0.5 * b.inertia() * v[2] * v[2];
             u += b.mass * g * q[1];
@@ -476,7 +487,7 @@ impl Engine {
 
     /// Projection onto the active constraints, with its energy change booked.
     fn project(&mut self) {
-        let before = self.total_energy();
+        let before = self.window_energy();
         let (lo, hi) = (self.lo, self.hi);
         let mut act = std::mem::take(&mut self.new_active);
         act.clear();
@@ -495,7 +506,7 @@ impl Engine {
         if self.new_active.len() != n_before {
             self.set_active();
         }
-        let after = self.total_energy();
+        let after = self.window_energy();
         self.energy.projection += before - after;
     }
 

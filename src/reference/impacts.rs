@@ -37,7 +37,7 @@ impl Engine {
                 });
             }
         }
-        let before = self.total_energy();
+        let before = self.window_energy();
         self.dynamics.project(
             &self.rc,
             lo,
@@ -47,7 +47,7 @@ impl Engine {
             &mut act,
             self.v_tol,
         );
-        let after = self.total_energy();
+        let after = self.window_energy();
         self.energy.impacts += before - after;
         self.impacts += 1;
         self.impact_fallbacks += 1;
