@@ -4,7 +4,10 @@
 
 use clap::{Parser, Subcommand};
 
+mod chain;
 mod impact;
+mod paper;
+mod plot;
 mod scene;
 mod theory;
 
@@ -19,6 +22,8 @@ struct Cli {
     command: Command,
 }
 
+// Parsed once per run: the size of the largest variant does not matter.
+#[allow(clippy::large_enum_variant)]
 #[derive(Subcommand)]
 enum Command {
     /// Resolve one multiple impact given as JSON (FILE, or - for stdin).
@@ -27,6 +32,10 @@ enum Command {
     Scene(scene::Args),
     /// Natural speed of the domino wave by the cooperative, extended and single collision models.
     Theory(theory::Args),
+    /// Simulate a row of dominoes (the paper's model) and report the wave.
+    Chain(chain::Args),
+    /// Regenerate the paper's Figs. 3–10 (CSV + SVG) with the reference engine.
+    Paper(paper::Args),
 }
 
 /// Parses the command line, runs the subcommand, returns the exit status.
@@ -36,6 +45,8 @@ pub fn run() -> i32 {
         Command::Impact(args) => impact::run(args),
         Command::Scene(args) => scene::run(args),
         Command::Theory(args) => theory::run(args),
+        Command::Chain(args) => chain::run(args),
+        Command::Paper(args) => paper::run_cmd(args),
     };
     match result {
         Ok(()) => 0,

@@ -1,4 +1,5 @@
 #![allow(dead_code)]
 pub mod compliant;
+pub mod cooperative;
 pub mod hertz;
 pub mod leaning;

@@ -1,0 +1,244 @@
+//! `topple chain`: a row of dominoes through an engine; the wave speeds, energy
+//! bookkeeping, time series and snapshots.
+
+use std::path::PathBuf;
+
+use anyhow::Context;
+
+use topple::domino::{Preset, RowParams, RowSpec};
+use topple::reference::{snapshot_svg, Integrator, Settings};
+
+/// Block type of Table 1.
+#[derive(Clone, Copy, Debug, clap::ValueEnum)]
+pub enum PresetArg {
+    /// Domino X (plastic, Stronge 1987).
+    X,
+    /// Domino T (tufnol, Stronge & Shu 1988).
+    T,
+    /// Domino P (perspex, Stronge & Shu 1988).
+    P,
+}
+
+impl From<PresetArg> for Preset {
+    fn from(p: PresetArg) -> Preset {
+        match p {
+            PresetArg::X => Preset::X,
+            PresetArg::T => Preset::T,
+            PresetArg::P => Preset::P,
+        }
+    }
+}
+
+/// Simulation engine.
+#[derive(Clone, Copy, Debug, Default, clap::ValueEnum)]
+pub enum EngineArg {
+    /// The paper's reduced-coordinate model (src/reference).
+    #[default]
+    Reference,
+}
+
+/// Arguments of `topple chain`.
+#[derive(clap::Args, Debug)]
+pub struct Args {
+    /// Block type (Table 1).
+    #[arg(long, value_enum, default_value = "x")]
+    pub preset: PresetArg,
+    /// Gap over height, s/h.
+    #[arg(long)]
+    pub spacing_ratio: f64,
+    /// Number of blocks.
+    #[arg(long, default_value_t = 40)]
+    pub n: usize,
+    /// Dimensionless initial angular velocity of block 1, θ̇₁ √(h/g).
+    #[arg(long, default_value_t = 1.0)]
+    pub push: f64,
+    /// Use the ideal material of Sec. 3.2 (μ1 = 0, e1 = 0, μ2 = 0.9, e2 = 0)
+    /// before the overrides below.
+    #[arg(long)]
+    pub ideal: bool,
+    /// Sliding friction between blocks (sets --mu1-stick too unless given).
+    #[arg(long)]
+    pub mu1: Option<f64>,
+    /// Restitution between blocks.
+    #[arg(long)]
+    pub e1: Option<f64>,
+    /// Sliding friction with the ground (sets --mu2-stick too unless given).
+    #[arg(long)]
+    pub mu2: Option<f64>,
+    /// Restitution with the ground.
+    #[arg(long)]
+    pub e2: Option<f64>,
+    /// Sticking friction between blocks.
+    #[arg(long)]
+    pub mu1_stick: Option<f64>,
+    /// Sticking friction with the ground.
+    #[arg(long)]
+    pub mu2_stick: Option<f64>,
+    /// Contact stiffness between blocks (N/m^α).
+    #[arg(long)]
+    pub k1: Option<f64>,
+    /// Contact stiffness with the ground (N/m^α).
+    #[arg(long)]
+    pub k2: Option<f64>,
+    /// Points under a standing block.
+    #[arg(long)]
+    pub lambda: Option<usize>,
+    /// Exponent of the contact law.
+    #[arg(long)]
+    pub alpha: Option<f64>,
+    /// Factor on the friction coefficients inside impacts (0.5 in the paper).
+    #[arg(long)]
+    pub impact_friction_factor: Option<f64>,
+    /// Block height h (m).
+    #[arg(long)]
+    pub height: Option<f64>,
+    /// Block thickness d (m).
+    #[arg(long)]
+    pub thickness: Option<f64>,
+    /// Engine.
+    #[arg(long, value_enum, default_value = "reference")]
+    pub engine: EngineArg,
+    /// Accurate integration at this tolerance (adaptive Dormand–Prince and
+    /// adaptive impacts) instead of the paper's improved Euler at 1e-4 s.
+    #[arg(long)]
+    pub tolerance: Option<f64>,
+    /// Fixed time step of the paper's integration (s).
+    #[arg(long, default_value_t = 1e-4)]
+    pub dt: f64,
+    /// Freeze blocks behind the wave below this speed (fraction of √(gh)) and
+    /// acceleration (fraction of g); 0 never freezes.
+    #[arg(long)]
+    pub freeze_tolerance: Option<f64>,
+    /// Print the report as JSON.
+    #[arg(long)]
+    pub json: bool,
+    /// Record θ and θ̇ of these blocks (1-based, comma-separated).
+    #[arg(long, value_delimiter = ',')]
+    pub series: Vec<usize>,
+    /// Write snapshots of the row at these times (s) to --svg.
+    #[arg(long, value_delimiter = ',')]
+    pub snapshots: Vec<f64>,
+    /// SVG file for the snapshots.
+    #[arg(long)]
+    pub svg: Option<PathBuf>,
+}
+
+/// Row parameters from a preset and the overrides.
+pub fn params(args: &Args) -> RowParams {
+    let mut p = Preset::from(args.preset).params();
+    if args.ideal {
+        p = p.ideal();
+    }
+    if let Some(v) = args.height {
+        p.block.height = v;
+    }
+    if let Some(v) = args.thickness {
+        p.block.thickness = v;
+    }
+    if let Some(v) = args.mu1 {
+        p.mu1 = v;
+        p.mu1_stick = args.mu1_stick.unwrap_or(v);
+    }
+    if let Some(v) = args.mu1_stick {
+        p.mu1_stick = v;
+    }
+    if let Some(v) = args.mu2 {
+        p.mu2 = v;
+        p.mu2_stick = args.mu2_stick.unwrap_or(v);
+    }
+    if let Some(v) = args.mu2_stick {
+        p.mu2_stick = v;
+    }
+    if let Some(v) = args.e1 {
+        p.e1 = v;
+    }
+    if let Some(v) = args.e2 {
+        p.e2 = v;
+    }
+    if let Some(v) = args.k1 {
+        p.k1 = v;
+    }
+    if let Some(v) = args.k2 {
+        p.k2 = v;
+    }
+    if let Some(v) = args.lambda {
+        p.lambda_points = v;
+    }
+    if let Some(v) = args.impact_friction_factor {
+        p.impact_friction_factor = v;
+    }
+    if let Some(v) = args.alpha {
+        p.alpha = v;
+    }
+    p
+}
+
+pub fn run(args: Args) -> anyhow::Result<()> {
+    let p = params(&args);
+    let row = RowSpec::new(p, args.spacing_ratio * p.block.height, args.n, args.push);
+    let mut settings = match args.tolerance {
+        Some(tol) => Settings::accurate(tol),
+        None => Settings {
+            integrator: Integrator::Paper { dt: args.dt },
+            ..Default::default()
+        },
+    };
+    if let Some(f) = args.freeze_tolerance {
+        settings.freeze_tolerance = f;
+    }
+    settings.series_blocks = args.series.clone();
+    settings.snapshot_times = args.snapshots.clone();
+    let out = match args.engine {
+        EngineArg::Reference => topple::reference::run(&row, &settings)?,
+    };
+    if let Some(path) = &args.svg {
+        let svg = snapshot_svg(&p.block, &out.snapshots, 0, row.n - 1);
+        std::fs::write(path, svg).with_context(|| format!("writing {}", path.display()))?;
+    }
+    let r = &out.report;
+    if args.json {
+        println!("{}", serde_json::to_string_pretty(r)?);
+        return Ok(());
+    }
+    println!(
+        "engine {}  s/h = {}  n = {}  push = {}",
+        r.engine, args.spacing_ratio, row.n, row.push
+    );
+    println!("block  hit time (s)   t_i (s)     v̂_i");
+    for (i, t) in r.hit_times.iter().enumerate() {
+        match (r.intervals.get(i), r.speeds.get(i)) {
+            (Some(ti), Some(v)) => println!("{:5}  {:12.6}  {:10.6}  {:8.4}", i + 1, t, ti, v),
+            _ => println!("{:5}  {:12.6}", i + 1, t),
+        }
+    }
+    match r.natural_speed_spread {
+        Some(s) => println!(
+            "natural speed v̂_na = {:.4} ± {:.4} (min {:.4}, max {:.4}, {} blocks)",
+            s.mean, s.std_dev, s.min, s.max, s.count
+        ),
+        None => println!("natural speed: the wave stopped before block 8"),
+    }
+    if let Some(e) = r.energy {
+        println!(
+            "energy (J): initial {:.6e}, kinetic {:.6e}, potential {:.6e}, impacts {:.6e}, friction {:.6e}, projection {:.3e}, frozen {:.3e}, residual {:.3e}",
+            e.initial, e.kinetic, e.potential, e.impacts, e.friction, e.projection, e.frozen, e.residual
+        );
+    }
+    println!(
+        "impacts {} ({} plastic fallbacks), max penetration {:.3e} m, blocks turning back: {:?}, simulated {:.4} s in {:.3} s ({} steps)",
+        r.impacts,
+        r.impact_fallbacks,
+        r.max_penetration.unwrap_or(0.0),
+        r.reversed_blocks,
+        r.simulated_time,
+        r.run_time,
+        out.steps
+    );
+    for s in &r.series {
+        println!("# series block {}: t, θ, θ̇", s.block);
+        for k in 0..s.time.len() {
+            println!("{:.6} {:.6} {:.6}", s.time[k], s.theta[k], s.theta_dot[k]);
+        }
+    }
+    Ok(())
+}

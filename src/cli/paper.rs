@@ -1,0 +1,420 @@
+//! `topple paper --out DIR`: regenerates the paper's Figs. 3–10 with the
+//! reference engine, as CSV files and SVG plots. Sweeps run in parallel
+//! (rayon) with a progress bar.
+
+use std::path::{Path, PathBuf};
+
+use anyhow::Context;
+use indicatif::{ProgressBar, ProgressStyle};
+use rayon::prelude::*;
+
+use super::plot::{csv, plot, Curve};
+use topple::domino::{ChainReport, Preset, RowParams, RowSpec};
+use topple::reference::{run, snapshot_svg, Integrator, Settings};
+
+/// Arguments of `topple paper`.
+#[derive(clap::Args, Debug)]
+pub struct Args {
+    /// Output directory (created if missing).
+    #[arg(long)]
+    pub out: PathBuf,
+    /// Blocks per row in the sweeps.
+    #[arg(long, default_value_t = 40)]
+    pub n: usize,
+    /// Only these figures (3..=10); all by default.
+    #[arg(long, value_delimiter = ',')]
+    pub figs: Vec<u32>,
+    /// Accurate integration at this tolerance instead of the paper's.
+    #[arg(long)]
+    pub tolerance: Option<f64>,
+    /// Spacing ratios s/h of the sweeps of Figs. 4 and 5 (default 0.1 to 0.6
+    /// in steps of 0.05).
+    #[arg(long, value_delimiter = ',')]
+    pub spacings: Vec<f64>,
+    /// Wall-clock limit per run (s); a run that hits it keeps the blocks it
+    /// measured and is reported on stderr.
+    #[arg(long, default_value_t = 120.0)]
+    pub run_limit: f64,
+}
+
+struct Job {
+    fig: u32,
+    /// Curve key within the figure.
+    key: String,
+    /// x coordinate in the figure (parameter value) when it is a sweep.
+    x: f64,
+    row: RowSpec,
+    settings: Settings,
+}
+
+fn with_ground_ideal(mut p: RowParams) -> RowParams {
+    p.mu2 = 0.9;
+    p.mu2_stick = 0.9;
+    p.e2 = 0.0;
+    p
+}
+
+fn set_mu1(mut p: RowParams, mu: f64) -> RowParams {
+    p.mu1 = mu;
+    p.mu1_stick = mu;
+    p
+}
+
+fn set_mu2(mut p: RowParams, mu: f64) -> RowParams {
+    p.mu2 = mu;
+    p.mu2_stick = mu;
+    p
+}
+
+fn natural(r: &ChainReport) -> f64 {
+    r.natural_speed.unwrap_or(f64::NAN)
+}
+
+pub fn run_cmd(args: Args) -> anyhow::Result<()> {
+    std::fs::create_dir_all(&args.out)
+        .with_context(|| format!("creating {}", args.out.display()))?;
+    let want = |f: u32| args.figs.is_empty() || args.figs.contains(&f);
+    let mut base = match args.tolerance {
+        Some(t) => Settings::accurate(t),
+        None => Settings {
+            integrator: Integrator::Paper { dt: 1e-4 },
+            ..Default::default()
+        },
+    };
+    base.wall_time_limit = Some(args.run_limit);
+    let n = args.n;
+    let mut jobs: Vec<Job> = Vec::new();
+    let x = Preset::X.params();
+    let spacings: Vec<f64> = if args.spacings.is_empty() {
+        (0..11).map(|k| 0.1 + 0.05 * k as f64).collect()
+    } else {
+        args.spacings.clone()
+    };
+    let three = [0.18, 0.35, 0.52];
+    let mk = |fig: u32,
+              key: String,
+              xv: f64,
+              p: RowParams,
+              sh: f64,
+              push: f64,
+              n: usize,
+              s: &Settings| Job {
+        fig,
+        key,
+        x: xv,
+        row: RowSpec::new(p, sh * p.block.height, n, push),
+        settings: s.clone(),
+    };
+    if want(3) {
+        for push in [1.8, 0.5] {
+            jobs.push(mk(3, format!("push {push}"), 0.0, x, 0.18, push, n, &base));
+        }
+    }
+    if want(4) {
+        for (name, pr) in [("T", Preset::T), ("P", Preset::P)] {
+            for &sh in &spacings {
+                jobs.push(mk(4, name.into(), sh, pr.params(), sh, 1.0, n, &base));
+            }
+        }
+    }
+    if want(5) {
+        let t = Preset::T.params();
+        for &sh in &spacings {
+            jobs.push(mk(
+                5,
+                "mu1 = 0, e1 = 0".into(),
+                sh,
+                t.ideal(),
+                sh,
+                1.0,
+                n,
+                &base,
+            ));
+            jobs.push(mk(
+                5,
+                "mu1 = 0.15, e1 = 0".into(),
+                sh,
+                set_mu1(t.ideal(), 0.15),
+                sh,
+                1.0,
+                n,
+                &base,
+            ));
+        }
+    }
+    if want(6) || want(7) {
+        let series = Settings {
+            series_blocks: vec![7, 8, 9, 10],
+            series_interval: 2e-4,
+            ..base.clone()
+        };
+        jobs.push(mk(7, "Table 1".into(), 0.0, x, 0.52, 1.0, 20, &series));
+        jobs.push(mk(
+            7,
+            "ideal".into(),
+            0.0,
+            x.ideal(),
+            0.52,
+            1.0,
+            20,
+            &series,
+        ));
+    }
+    if want(8) {
+        for push in [0.5, 1.0, 1.8] {
+            jobs.push(mk(
+                8,
+                format!("Table 1, push {push}"),
+                0.0,
+                x,
+                0.52,
+                push,
+                n,
+                &base,
+            ));
+            jobs.push(mk(
+                8,
+                format!("ideal, push {push}"),
+                0.0,
+                x.ideal(),
+                0.52,
+                push,
+                n,
+                &base,
+            ));
+        }
+    }
+    if want(9) {
+        let g = with_ground_ideal(x);
+        for &sh in &three {
+            for mu1 in [0.0, 0.1, 0.2, 0.3, 0.4, 0.5] {
+                let mut p = set_mu1(g, mu1);
+                p.e1 = 0.0;
+                jobs.push(mk(9, format!("a s/h {sh}"), mu1, p, sh, 1.0, n, &base));
+            }
+            for e1 in [0.0, 0.2, 0.4, 0.6, 0.8, 0.9] {
+                let mut p = set_mu1(g, 0.0);
+                p.e1 = e1;
+                jobs.push(mk(9, format!("b s/h {sh}"), e1, p, sh, 1.0, n, &base));
+            }
+        }
+    }
+    if want(10) {
+        for &sh in &three {
+            for mu2 in [0.2, 0.3, 0.4, 0.5, 0.7, 0.9] {
+                let mut p = set_mu2(set_mu1(x, 0.0), mu2);
+                p.e1 = 0.0;
+                p.e2 = 0.0;
+                jobs.push(mk(10, format!("a s/h {sh}"), mu2, p, sh, 1.0, n, &base));
+            }
+            for e2 in [0.0, 0.2, 0.4, 0.6, 0.8] {
+                let mut p = set_mu1(with_ground_ideal(x), 0.0);
+                p.e1 = 0.0;
+                p.e2 = e2;
+                jobs.push(mk(10, format!("b s/h {sh}"), e2, p, sh, 1.0, n, &base));
+            }
+        }
+    }
+    let bar = ProgressBar::new(jobs.len() as u64);
+    bar.set_style(
+        ProgressStyle::with_template("{bar:40} {pos}/{len} runs, {elapsed} elapsed, eta {eta}")
+            .unwrap_or_else(|_| ProgressStyle::default_bar()),
+    );
+    let results: Vec<Result<ChainReport, String>> = jobs
+        .par_iter()
+        .map(|j| {
+            let r = run(&j.row, &j.settings)
+                .map(|o| o.report)
+                .map_err(|e| format!("fig {} {} x={}: {e}", j.fig, j.key, j.x));
+            bar.inc(1);
+            r
+        })
+        .collect();
+    bar.finish();
+    for (j, r) in jobs.iter().zip(results.iter()) {
+        match r {
+            Err(e) => eprintln!("warning: {e}"),
+            Ok(r) if r.stopped_early || r.impact_fallbacks > 0 => eprintln!(
+                "warning: fig {} {} x={}: {}{} plastic fallbacks, {} of {} blocks reached",
+                j.fig,
+                j.key,
+                j.x,
+                if r.stopped_early {
+                    "run limit hit, "
+                } else {
+                    ""
+                },
+                r.impact_fallbacks,
+                r.hit_times.len(),
+                j.row.n
+            ),
+            _ => {}
+        }
+    }
+    let out = &args.out;
+    let pick = |fig: u32| -> Vec<(&Job, &ChainReport)> {
+        jobs.iter()
+            .zip(results.iter())
+            .filter(|(j, _)| j.fig == fig)
+            .filter_map(|(j, r)| r.as_ref().ok().map(|r| (j, r)))
+            .collect()
+    };
+    let keys = |v: &[(&Job, &ChainReport)]| -> Vec<String> {
+        let mut k: Vec<String> = Vec::new();
+        for (j, _) in v {
+            if !k.contains(&j.key) {
+                k.push(j.key.clone());
+            }
+        }
+        k
+    };
+    // speeds along the row (Figs. 3, 8)
+    let along = |fig: u32, title: &str| -> anyhow::Result<()> {
+        let v = pick(fig);
+        let mut rows = Vec::new();
+        let mut curves = Vec::new();
+        for (j, r) in &v {
+            let pts: Vec<(f64, f64)> = r
+                .speeds
+                .iter()
+                .enumerate()
+                .map(|(i, s)| ((i + 1) as f64, *s))
+                .collect();
+            for (i, s) in &pts {
+                rows.push(vec![j.row.push, *i, *s]);
+            }
+            curves.push(Curve {
+                name: j.key.clone(),
+                points: pts,
+                markers: true,
+            });
+        }
+        csv(
+            &out.join(format!("fig{fig}.csv")),
+            "push,block,v_hat",
+            &rows,
+        )?;
+        plot(
+            &out.join(format!("fig{fig}.svg")),
+            title,
+            "block n",
+            "v̂",
+            &curves,
+        )
+    };
+    if want(3) {
+        along(3, "Fig. 3: Domino X, Table 1, s/h = 0.18")?;
+    }
+    if want(8) {
+        along(8, "Fig. 8: Domino X, s/h = 0.52, pushes 0.5/1.0/1.8")?;
+    }
+    // sweeps (Figs. 4, 5, 9, 10)
+    let sweep = |fig: u32, sub: &str, title: &str, xl: &str| -> anyhow::Result<()> {
+        let v: Vec<(&Job, &ChainReport)> = pick(fig)
+            .into_iter()
+            .filter(|(j, _)| sub.is_empty() || j.key.starts_with(sub))
+            .collect();
+        let mut rows = Vec::new();
+        let mut curves = Vec::new();
+        for (ki, k) in keys(&v).iter().enumerate() {
+            let pts: Vec<(f64, f64)> = v
+                .iter()
+                .filter(|(j, _)| &j.key == k)
+                .map(|(j, r)| (j.x, natural(r)))
+                .collect();
+            for (xv, yv) in &pts {
+                let spread = v
+                    .iter()
+                    .find(|(j, _)| &j.key == k && j.x == *xv)
+                    .and_then(|(_, r)| r.natural_speed_spread)
+                    .map(|s| s.std_dev)
+                    .unwrap_or(f64::NAN);
+                rows.push(vec![ki as f64, *xv, *yv, spread]);
+            }
+            curves.push(Curve {
+                name: k.trim_start_matches(sub).trim().to_string(),
+                points: pts,
+                markers: false,
+            });
+        }
+        let name = format!("fig{fig}{sub}");
+        let header = format!("curve({}),x,v_na,v_na_std", keys(&v).join("|"));
+        csv(&out.join(format!("{name}.csv")), &header, &rows)?;
+        plot(&out.join(format!("{name}.svg")), title, xl, "v̂_na", &curves)
+    };
+    if want(4) {
+        sweep(4, "", "Fig. 4: Domino T and P, Table 1", "s/h")?;
+    }
+    if want(5) {
+        sweep(5, "", "Fig. 5: Domino T, mu2 = 0.9, e2 = 0", "s/h")?;
+    }
+    if want(9) {
+        sweep(9, "a", "Fig. 9a: X, mu2 = 0.9, e1 = e2 = 0", "mu1")?;
+        sweep(9, "b", "Fig. 9b: X, mu2 = 0.9, mu1 = e2 = 0", "e1")?;
+    }
+    if want(10) {
+        sweep(10, "a", "Fig. 10a: X, mu1 = e1 = e2 = 0", "mu2")?;
+        sweep(10, "b", "Fig. 10b: X, mu2 = 0.9, mu1 = e1 = 0", "e2")?;
+    }
+    if want(7) || want(6) {
+        let v = pick(7);
+        for (j, r) in &v {
+            let tbar = j.row.params.time_scale();
+            let mut rows = Vec::new();
+            let mut curves = Vec::new();
+            for s in &r.series {
+                let t0 = r.hit_times.get(s.block - 1).cloned().unwrap_or(0.0);
+                let pts: Vec<(f64, f64)> = s
+                    .time
+                    .iter()
+                    .zip(s.theta_dot.iter())
+                    .filter(|(t, _)| **t >= t0)
+                    .map(|(t, w)| ((t - t0) / tbar, w * tbar))
+                    .collect();
+                for (a, b) in &pts {
+                    rows.push(vec![s.block as f64, *a, *b]);
+                }
+                curves.push(Curve {
+                    name: format!("block {}", s.block),
+                    points: pts,
+                    markers: false,
+                });
+            }
+            let tag = if j.key == "ideal" { "b" } else { "a" };
+            csv(
+                &out.join(format!("fig7{tag}.csv")),
+                "block,t_over_tbar,theta_dot_hat",
+                &rows,
+            )?;
+            if want(7) {
+                plot(
+                    &out.join(format!("fig7{tag}.svg")),
+                    &format!("Fig. 7{tag}: Domino X, s/h = 0.52, {}", j.key),
+                    "t / t̄ (from the block's hit)",
+                    "θ̂ (clockwise)",
+                    &curves,
+                )?;
+            }
+            if want(6) {
+                // second pass with snapshots while the wave crosses blocks 8–12
+                let t8 = r.hit_times.get(7).cloned().unwrap_or(0.0);
+                let t12 = r.hit_times.get(11).cloned().unwrap_or(t8 + 0.1);
+                let times: Vec<f64> = (0..5).map(|k| t8 + (t12 - t8) * k as f64 / 4.0).collect();
+                let s = Settings {
+                    snapshot_times: times,
+                    series_blocks: Vec::new(),
+                    ..j.settings.clone()
+                };
+                let o = run(&j.row, &s).map_err(|e| anyhow::anyhow!("fig 6: {e}"))?;
+                let svg = snapshot_svg(&j.row.params.block, &o.snapshots, 4, 14.min(j.row.n - 1));
+                write(&out.join(format!("fig6{tag}.svg")), &svg)?;
+            }
+        }
+    }
+    println!("wrote figures to {}", out.display());
+    Ok(())
+}
+
+fn write(path: &Path, s: &str) -> anyhow::Result<()> {
+    std::fs::write(path, s).with_context(|| format!("writing {}", path.display()))
+}

@@ -1,0 +1,439 @@
+//! The smooth phase (paper Eqs. 17–20): contact forces of the closed contacts
+//! for a given contact *mode* (which contacts press, which stick, which slide
+//! and in which direction), the accelerations they give, the active-set search
+//! that finds the mode satisfying the complementarity conditions (Eqs. 18–20),
+//! and the projections that keep persistent contacts exactly closed.
+//!
+//! Units: SI (m, s, kg, N). The Delassus matrix W M⁻¹ W is banded (a contact
+//! couples two neighbouring blocks) and solved by [`Band`] in O(contacts).
+
+use super::band::Band;
+use super::geometry::{geom, kin, Geom, Kin, Surface};
+use crate::domino::RowParams;
+
+/// Friction state of a pressing contact.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) enum Mode {
+    /// No friction (μ = 0 at this surface).
+    Frictionless,
+    /// Tangential relative velocity held at zero, |F_t| ≤ μ_s F_n.
+    Stick,
+    /// Sliding with the sign `dir` = sgn v_t: F_t = −dir μ F_n.
+    Slide(f64),
+}
+
+/// A pressing (active) contact: slot `slot` of block `block` in `mode`.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Active {
+    pub block: usize,
+    pub slot: usize,
+    pub mode: Mode,
+}
+
+/// Read-only view of the row: blocks lo..hi move and their state is in `y`
+/// (x, y, φ, ẋ, ẏ, ω per block); the others are fixed at `pos`.
+#[derive(Clone, Copy)]
+pub(crate) struct View<'a> {
+    pub lo: usize,
+    pub hi: usize,
+    pub y: &'a [f64],
+    pub pos: &'a [[f64; 3]],
+}
+
+impl View<'_> {
+    #[inline]
+    pub fn q(&self, j: usize) -> [f64; 3] {
+        if j >= self.lo && j < self.hi {
+            let k = 6 * (j - self.lo);
+            [self.y[k], self.y[k + 1], self.y[k + 2]]
+        } else {
+            self.pos[j]
+        }
+    }
+    #[inline]
+    pub fn v(&self, j: usize) -> [f64; 3] {
+        if j >= self.lo && j < self.hi {
+            let k = 6 * (j - self.lo) + 3;
+            [self.y[k], self.y[k + 1], self.y[k + 2]]
+        } else {
+            [0.0; 3]
+        }
+    }
+    #[inline]
+    pub fn local(&self, j: Option<usize>) -> Option<usize> {
+        j.filter(|&j| j >= self.lo && j < self.hi)
+            .map(|j| j - self.lo)
+    }
+}
+
+/// One unknown of a contact system: its free bodies (window-local), the
+/// Jacobian row it constrains and the generalised-force column it acts by.
+#[derive(Clone, Copy, Debug, Default)]
+struct Unknown {
+    bodies: [Option<usize>; 2],
+    row: [[f64; 3]; 2],
+    col: [[f64; 3]; 2],
+}
+
+/// Results and buffers of the contact-force computation.
+#[derive(Debug, Default)]
+pub(crate) struct Dynamics {
+    band: Band,
+    unknowns: Vec<Unknown>,
+    geoms: Vec<Geom>,
+    kins: Vec<Kin>,
+    /// Normal force of each active contact (N).
+    pub fn_: Vec<f64>,
+    /// Tangential force of each active contact (N), along t.
+    pub ft: Vec<f64>,
+    /// Accelerations of the moving blocks (ẍ, ÿ, φ̈).
+    pub acc: Vec<[f64; 3]>,
+    /// Power of the contact forces Σ F_n δ̇ + F_t v_t (W); ≤ 0.
+    pub power: f64,
+    /// Tangential velocity of each active contact (m/s).
+    pub vt: Vec<f64>,
+    /// Gap of each active contact (m).
+    pub gap: Vec<f64>,
+    /// Whether each active contact still projects onto its face.
+    pub valid: Vec<bool>,
+}
+
+/// Constants of the row needed by the dynamics.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct RowConst {
+    pub p: RowParams,
+    pub n: usize,
+    pub inv_m: f64,
+    pub inv_i: f64,
+    /// Relative Tikhonov regularisation of the Delassus diagonal, for
+    /// redundant contact sets (a block standing on λ points).
+    pub reg: f64,
+}
+
+impl RowConst {
+    pub fn new(p: RowParams, n: usize) -> Self {
+        RowConst {
+            p,
+            n,
+            inv_m: 1.0 / p.block.mass,
+            inv_i: 1.0 / p.block.inertia(),
+            reg: 1e-10,
+        }
+    }
+    #[inline]
+    pub fn mu(&self, slot: usize) -> (f64, f64) {
+        match super::geometry::surface(slot, self.p.lambda_points) {
+            Surface::Ground => (self.p.mu2, self.p.mu2_stick),
+            Surface::Block => (self.p.mu1, self.p.mu1_stick),
+        }
+    }
+    #[inline]
+    pub fn geom(&self, view: &View, block: usize, slot: usize) -> Option<Geom> {
+        geom(
+            &self.p.block,
+            self.p.lambda_points,
+            self.n,
+            block,
+            slot,
+            |j| view.q(j),
+        )
+    }
+    #[inline]
+    pub fn kin(&self, view: &View, g: &Geom) -> Kin {
+        kin(g, |j| view.q(j), |j| view.v(j))
+    }
+    #[inline]
+    fn minv(&self, a: [f64; 3]) -> [f64; 3] {
+        [a[0] * self.inv_m, a[1] * self.inv_m, a[2] * self.inv_i]
+    }
+}
+
+#[inline]
+fn dot3(a: [f64; 3], b: [f64; 3]) -> f64 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+
+fn span(u: &Unknown) -> (usize, usize) {
+    let mut lo = usize::MAX;
+    let mut hi = 0;
+    for b in u.bodies.iter().flatten() {
+        lo = lo.min(*b);
+        hi = hi.max(*b);
+    }
+    (lo, hi)
+}
+
+impl Dynamics {
+    /// Assembles A = J M⁻¹ Cᵀ (+ reg · diag) of the current unknowns into the
+    /// band (rhs untouched except resized) and returns false if nothing to do.
+    fn assemble(&mut self, rc: &RowConst) {
+        let m = self.unknowns.len();
+        let mut bw = 0;
+        for r in 0..m {
+            let (_, hr) = span(&self.unknowns[r]);
+            for s in r + 1..m {
+                let (ls, _) = span(&self.unknowns[s]);
+                if ls > hr {
+                    break;
+                }
+                bw = bw.max(s - r);
+            }
+        }
+        let rhs = std::mem::take(&mut self.band.rhs);
+        self.band.reset(m, bw, bw);
+        self.band.rhs = rhs;
+        self.band.rhs.resize(m, 0.0);
+        for r in 0..m {
+            let ur = self.unknowns[r];
+            let lo = r.saturating_sub(bw);
+            let hi = (r + bw).min(m - 1);
+            let mut diag = 0.0;
+            for s in lo..=hi {
+                let us = &self.unknowns[s];
+                let mut v = 0.0;
+                for (a, ba) in ur.bodies.iter().enumerate() {
+                    let Some(ba) = ba else { continue };
+                    for (b, bb) in us.bodies.iter().enumerate() {
+                        if Some(*ba) == *bb {
+                            v += dot3(ur.row[a], rc.minv(us.col[b]));
+                        }
+                    }
+                }
+                if v != 0.0 {
+                    self.band.add(r, s, v);
+                }
+                if s == r {
+                    diag = v;
+                }
+            }
+            self.band.add(r, r, rc.reg * diag.abs().max(1e-30));
+        }
+    }
+
+    /// Contact forces and accelerations of the moving blocks for the `active`
+    /// contacts in their modes (Eqs. 17, 19, 20 with the mode fixed). Returns
+    /// false if the contact system is singular.
+    pub fn forces(&mut self, rc: &RowConst, view: &View, active: &[Active]) -> bool {
+        let nb = view.hi - view.lo;
+        let g = rc.p.gravity;
+        self.unknowns.clear();
+        self.geoms.clear();
+        self.kins.clear();
+        self.fn_.clear();
+        self.ft.clear();
+        self.vt.clear();
+        self.gap.clear();
+        self.valid.clear();
+        self.band.rhs.clear();
+        for a in active {
+            let gm = rc.geom(view, a.block, a.slot).expect("active slot exists");
+            let k = rc.kin(view, &gm);
+            let bodies = [view.local(Some(gm.corner)), view.local(gm.face)];
+            let (mu, _) = rc.mu(a.slot);
+            let mut col = k.jn;
+            if let Mode::Slide(dir) = a.mode {
+                for (c, t) in col.iter_mut().zip(k.jt.iter()) {
+                    for x in 0..3 {
+                        c[x] -= dir * mu * t[x];
+                    }
+                }
+            }
+            let rhs_of = |row: &[[f64; 3]; 2], s: f64| {
+                let mut r = -s;
+                for (b, body) in bodies.iter().enumerate() {
+                    if body.is_some() {
+                        r += g * row[b][1] * 1.0; // −J M⁻¹ G with G = (0, −m g, 0)
+                    }
+                }
+                r
+            };
+            self.unknowns.push(Unknown {
+                bodies,
+                row: k.jn,
+                col,
+            });
+            self.band.rhs.push(rhs_of(&k.jn, k.sn));
+            if a.mode == Mode::Stick {
+                self.unknowns.push(Unknown {
+                    bodies,
+                    row: k.jt,
+                    col: k.jt,
+                });
+                self.band.rhs.push(rhs_of(&k.jt, k.st));
+            }
+            self.vt.push(k.vt);
+            self.gap.push(gm.gap);
+            self.valid.push(gm.valid);
+            self.geoms.push(gm);
+            self.kins.push(k);
+        }
+        self.acc.clear();
+        self.acc.resize(nb, [0.0, -g, 0.0]);
+        self.power = 0.0;
+        if self.unknowns.is_empty() {
+            return true;
+        }
+        self.assemble(rc);
+        if !self.band.solve() {
+            return false;
+        }
+        let mut r = 0;
+        for (c, a) in active.iter().enumerate() {
+            let (mu, _) = rc.mu(a.slot);
+            let fnn = self.band.rhs[r];
+            r += 1;
+            let ft = match a.mode {
+                Mode::Frictionless => 0.0,
+                Mode::Slide(dir) => -dir * mu * fnn,
+                Mode::Stick => {
+                    r += 1;
+                    self.band.rhs[r - 1]
+                }
+            };
+            self.fn_.push(fnn);
+            self.ft.push(ft);
+            let k = &self.kins[c];
+            self.power += fnn * k.gdot + ft * k.vt;
+            let bodies = [
+                view.local(Some(self.geoms[c].corner)),
+                view.local(self.geoms[c].face),
+            ];
+            for (b, body) in bodies.iter().enumerate() {
+                if let Some(b_) = body {
+                    let f = [
+                        fnn * k.jn[b][0] + ft * k.jt[b][0],
+                        fnn * k.jn[b][1] + ft * k.jt[b][1],
+                        fnn * k.jn[b][2] + ft * k.jt[b][2],
+                    ];
+                    let d = rc.minv(f);
+                    for x in 0..3 {
+                        self.acc[*b_][x] += d[x];
+                    }
+                }
+            }
+        }
+        true
+    }
+
+    /// Normal relative acceleration δ̈ = J q̈ + S of a candidate under the
+    /// accelerations last computed.
+    pub fn gddot(&self, view: &View, g: &Geom, k: &Kin) -> f64 {
+        let mut s = k.sn;
+        if let Some(a) = view.local(Some(g.corner)) {
+            s += dot3(k.jn[0], self.acc[a]);
+        }
+        if let Some(b) = view.local(g.face) {
+            s += dot3(k.jn[1], self.acc[b]);
+        }
+        s
+    }
+
+    /// Projects the moving blocks onto the constraints of the active contacts:
+    /// velocities so that δ̇ = 0 and, for sticking contacts, v_t = 0, then
+    /// positions so that every gap is 0 (one Gauss–Newton step with the metric
+    /// M, so the change is the smallest in kinetic-energy norm). The velocity
+    /// projection is unilateral: a contact that would have to be pulled
+    /// harder than a contact separating at `v_tol` (m/s) is separating; it is
+    /// removed from `active` and the projection repeated. Works on `y` in place.
+    pub fn project(
+        &mut self,
+        rc: &RowConst,
+        lo: usize,
+        hi: usize,
+        y: &mut [f64],
+        pos: &[[f64; 3]],
+        active: &mut Vec<Active>,
+        v_tol: f64,
+    ) {
+        let mut y0: Vec<f64> = Vec::new();
+        for pass in 0..2 {
+            let mut rounds = 0;
+            loop {
+                rounds += 1;
+                if active.is_empty() {
+                    return;
+                }
+                if pass == 0 {
+                    if rounds == 1 {
+                        y0.clear();
+                        y0.extend_from_slice(y);
+                    } else {
+                        y.copy_from_slice(&y0);
+                    }
+                }
+                self.unknowns.clear();
+                self.band.rhs.clear();
+                let mut owner: Vec<(usize, bool)> = Vec::new();
+                {
+                    let view = View { lo, hi, y, pos };
+                    for (c, a) in active.iter().enumerate() {
+                        let gm = rc.geom(&view, a.block, a.slot).expect("slot exists");
+                        let k = rc.kin(&view, &gm);
+                        let bodies = [view.local(Some(gm.corner)), view.local(gm.face)];
+                        if bodies.iter().all(|b| b.is_none()) {
+                            continue;
+                        }
+                        self.unknowns.push(Unknown {
+                            bodies,
+                            row: k.jn,
+                            col: k.jn,
+                        });
+                        owner.push((c, true));
+                        self.band
+                            .rhs
+                            .push(if pass == 1 { -gm.gap } else { -k.gdot });
+                        if pass == 0 && a.mode == Mode::Stick {
+                            self.unknowns.push(Unknown {
+                                bodies,
+                                row: k.jt,
+                                col: k.jt,
+                            });
+                            owner.push((c, false));
+                            self.band.rhs.push(-k.vt);
+                        }
+                    }
+                }
+                if self.unknowns.is_empty() {
+                    return;
+                }
+                self.assemble(rc);
+                if !self.band.solve() {
+                    return;
+                }
+                if pass == 0 && rounds < 20 {
+                    // drop the contacts that would be pulled together by more
+                    // than the impulse that closes a contact separating at the
+                    // velocity tolerance (a small pull is the persistence of a
+                    // contact that separates slower than that)
+                    let pull = 2.0 * rc.p.block.mass * v_tol;
+                    let mut drop: Vec<usize> = owner
+                        .iter()
+                        .zip(self.band.rhs.iter())
+                        .filter(|((_, normal), p)| *normal && **p < -pull)
+                        .map(|((c, _), _)| *c)
+                        .collect();
+                    if !drop.is_empty() {
+                        drop.sort_unstable();
+                        drop.dedup();
+                        for c in drop.into_iter().rev() {
+                            active.remove(c);
+                        }
+                        continue;
+                    }
+                }
+                let off = if pass == 1 { 0 } else { 3 };
+                for (u, mu) in self.unknowns.iter().zip(self.band.rhs.iter()) {
+                    for (b, body) in u.bodies.iter().enumerate() {
+                        if let Some(b_) = body {
+                            let d = rc.minv(u.col[b]);
+                            for x in 0..3 {
+                                y[6 * b_ + off + x] += mu * d[x];
+                            }
+                        }
+                    }
+                }
+                break;
+            }
+        }
+    }
+}

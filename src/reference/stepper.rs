@@ -1,0 +1,174 @@
+//! Explicit Runge–Kutta steps for the smooth phase with the contact mode held
+//! fixed: the paper's improved Euler (Heun, order 2; Sec. 3.1) and the
+//! Dormand–Prince 5(4) pair with an embedded error estimate (Dormand & Prince
+//! 1980; the coefficients are the published ones).
+
+/// A Butcher tableau.
+pub(crate) struct Tableau {
+    /// Stage nodes c_i.
+    pub c: &'static [f64],
+    /// Lower-triangular a_ij, row i holds the i coefficients of stage i.
+    pub a: &'static [&'static [f64]],
+    /// Weights of the propagated solution.
+    pub b: &'static [f64],
+    /// Weights of the error estimate (b − b̂), if the pair has one.
+    pub e: Option<&'static [f64]>,
+}
+
+/// Improved Euler (Heun's method), the paper's integrator.
+pub(crate) const HEUN: Tableau = Tableau {
+    c: &[0.0, 1.0],
+    a: &[&[], &[1.0]],
+    b: &[0.5, 0.5],
+    e: None,
+};
+
+/// Dormand–Prince 5(4).
+pub(crate) const DOPRI5: Tableau = Tableau {
+    c: &[0.0, 0.2, 0.3, 0.8, 8.0 / 9.0, 1.0, 1.0],
+    a: &[
+        &[],
+        &[0.2],
+        &[3.0 / 40.0, 9.0 / 40.0],
+        &[44.0 / 45.0, -56.0 / 15.0, 32.0 / 9.0],
+        &[
+            19372.0 / 6561.0,
+            -25360.0 / 2187.0,
+            64448.0 / 6561.0,
+            -212.0 / 729.0,
+        ],
+        &[
+            9017.0 / 3168.0,
+            -355.0 / 33.0,
+            46732.0 / 5247.0,
+            49.0 / 176.0,
+            -5103.0 / 18656.0,
+        ],
+        &[
+            35.0 / 384.0,
+            0.0,
+            500.0 / 1113.0,
+            125.0 / 192.0,
+            -2187.0 / 6784.0,
+            11.0 / 84.0,
+        ],
+    ],
+    b: &[
+        35.0 / 384.0,
+        0.0,
+        500.0 / 1113.0,
+        125.0 / 192.0,
+        -2187.0 / 6784.0,
+        11.0 / 84.0,
+        0.0,
+    ],
+    e: Some(&[
+        35.0 / 384.0 - 5179.0 / 57600.0,
+        0.0,
+        500.0 / 1113.0 - 7571.0 / 16695.0,
+        125.0 / 192.0 - 393.0 / 640.0,
+        -2187.0 / 6784.0 + 92097.0 / 339200.0,
+        11.0 / 84.0 - 187.0 / 2100.0,
+        -1.0 / 40.0,
+    ]),
+};
+
+/// Stage buffers, reused between steps.
+#[derive(Debug, Default)]
+pub(crate) struct Stages {
+    k: Vec<Vec<f64>>,
+    tmp: Vec<f64>,
+    /// Error estimate of the last step (absolute, per component).
+    pub err: Vec<f64>,
+}
+
+impl Stages {
+    /// One step of size `h` from `y0` with derivative `k0 = f(y0)`; the result
+    /// goes to `y1`. `f(y, dy)` returns false if the derivative cannot be
+    /// computed. Returns false in that case.
+    pub fn step(
+        &mut self,
+        tab: &Tableau,
+        h: f64,
+        y0: &[f64],
+        k0: &[f64],
+        y1: &mut Vec<f64>,
+        mut f: impl FnMut(&[f64], &mut [f64]) -> bool,
+    ) -> bool {
+        let n = y0.len();
+        let s = tab.c.len();
+        if self.k.len() < s {
+            self.k.resize(s, Vec::new());
+        }
+        for k in self.k.iter_mut() {
+            k.resize(n, 0.0);
+        }
+        self.tmp.resize(n, 0.0);
+        self.k[0].copy_from_slice(k0);
+        for i in 1..s {
+            let ai = tab.a[i];
+            for x in 0..n {
+                let mut acc = 0.0;
+                for (j, aij) in ai.iter().enumerate() {
+                    if *aij != 0.0 {
+                        acc += aij * self.k[j][x];
+                    }
+                }
+                self.tmp[x] = y0[x] + h * acc;
+            }
+            let (head, tail) = self.k.split_at_mut(i);
+            let _ = head;
+            if !f(&self.tmp, &mut tail[0]) {
+                return false;
+            }
+        }
+        y1.resize(n, 0.0);
+        for x in 0..n {
+            let mut acc = 0.0;
+            for (j, bj) in tab.b.iter().enumerate() {
+                if *bj != 0.0 {
+                    acc += bj * self.k[j][x];
+                }
+            }
+            y1[x] = y0[x] + h * acc;
+        }
+        self.err.resize(n, 0.0);
+        if let Some(e) = tab.e {
+            for x in 0..n {
+                let mut acc = 0.0;
+                for (j, ej) in e.iter().enumerate() {
+                    acc += ej * self.k[j][x];
+                }
+                self.err[x] = h * acc;
+            }
+        } else {
+            self.err.iter_mut().for_each(|v| *v = 0.0);
+        }
+        true
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    // y' = −y: one step's error must shrink as h^(order+1).
+    #[test]
+    fn orders_of_heun_and_dopri5() {
+        for (tab, order) in [(&HEUN, 2), (&DOPRI5, 5)] {
+            let mut st = Stages::default();
+            let mut errs = Vec::new();
+            for h in [0.1f64, 0.05] {
+                let mut y1 = Vec::new();
+                let ok = st.step(tab, h, &[1.0], &[-1.0], &mut y1, |y, dy| {
+                    dy[0] = -y[0];
+                    true
+                });
+                assert!(ok);
+                errs.push((y1[0] - (-h).exp()).abs());
+            }
+            let p = (errs[0] / errs[1]).log2();
+            assert!((p - (order as f64 + 1.0)).abs() < 0.3, "order {order}: {p}");
+        }
+    }
+}

@@ -1,0 +1,2 @@
+//! Checks the test oracle itself against published values.
+mod common;
