@@ -35,6 +35,10 @@ pub enum EngineArg {
     /// The paper's reduced-coordinate model (src/reference).
     #[default]
     Reference,
+    /// The row as a rapier2d-f64 world with topple's impacts.
+    Rapier,
+    /// The same world with Rapier's own impact response.
+    RapierNative,
 }
 
 /// Arguments of `topple chain`.
@@ -102,9 +106,18 @@ pub struct Args {
     /// adaptive impacts) instead of the paper's improved Euler at 1e-4 s.
     #[arg(long)]
     pub tolerance: Option<f64>,
-    /// Fixed time step of the paper's integration (s).
+    /// Fixed time step of the paper's integration (s); with a Rapier engine,
+    /// Rapier's time step.
     #[arg(long, default_value_t = 1e-4)]
     pub dt: f64,
+    /// Rapier engines: impact window, the number of closed contacts from the
+    /// struck pair beyond which bodies are left out of an impact.
+    #[arg(long, default_value_t = 8)]
+    pub window: usize,
+    /// Rapier engines: stop after this much simulated time (s) if the last
+    /// block has not been hit.
+    #[arg(long, default_value_t = 60.0)]
+    pub max_time: f64,
     /// Freeze blocks behind the wave below this speed (fraction of √(gh)) and
     /// acceleration (fraction of g); 0 never freezes.
     #[arg(long)]
@@ -188,9 +201,35 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     }
     settings.series_blocks = args.series.clone();
     settings.snapshot_times = args.snapshots.clone();
-    let out = match args.engine {
-        EngineArg::Reference => topple::reference::run(&row, &settings)?,
+    let rapier_engine = match args.engine {
+        EngineArg::Reference => None,
+        EngineArg::Rapier => Some(topple::rapier::scene::Engine::Rapier),
+        EngineArg::RapierNative => Some(topple::rapier::scene::Engine::RapierNative),
     };
+    if let Some(engine) = rapier_engine {
+        anyhow::ensure!(
+            args.dt > 0.0 && args.dt.is_finite(),
+            "--dt must be a positive time step"
+        );
+        let solver = topple::rapier::scene::SolverSpec {
+            dt: args.dt,
+            tolerance: args.tolerance,
+            max_group_hops: Some(args.window),
+            ..Default::default()
+        };
+        let report = topple::rapier::chain::run_row(&row, engine, solver, args.max_time)?;
+        if args.json {
+            println!("{}", serde_json::to_string_pretty(&report)?);
+        } else {
+            print_report(&report, args.spacing_ratio, &row);
+            println!(
+                "impacts {}, simulated {:.4} s in {:.3} s",
+                report.impacts, report.simulated_time, report.run_time
+            );
+        }
+        return Ok(());
+    }
+    let out = topple::reference::run(&row, &settings)?;
     if let Some(path) = &args.svg {
         let svg = snapshot_svg(&p.block, &out.snapshots, 0, row.n - 1);
         std::fs::write(path, svg).with_context(|| format!("writing {}", path.display()))?;
@@ -200,9 +239,31 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         println!("{}", serde_json::to_string_pretty(r)?);
         return Ok(());
     }
+    print_report(r, args.spacing_ratio, &row);
+    println!(
+        "impacts {} ({} plastic fallbacks), max penetration {:.3e} m, blocks turning back: {:?}, simulated {:.4} s in {:.3} s ({} steps)",
+        r.impacts,
+        r.impact_fallbacks,
+        r.max_penetration.unwrap_or(0.0),
+        r.reversed_blocks,
+        r.simulated_time,
+        r.run_time,
+        out.steps
+    );
+    for s in &r.series {
+        println!("# series block {}: t, θ, θ̇", s.block);
+        for k in 0..s.time.len() {
+            println!("{:.6} {:.6} {:.6}", s.time[k], s.theta[k], s.theta_dot[k]);
+        }
+    }
+    Ok(())
+}
+
+/// The text report shared by every engine.
+fn print_report(r: &topple::domino::ChainReport, spacing_ratio: f64, row: &RowSpec) {
     println!(
         "engine {}  s/h = {}  n = {}  push = {}",
-        r.engine, args.spacing_ratio, row.n, row.push
+        r.engine, spacing_ratio, row.n, row.push
     );
     println!("block  hit time (s)   t_i (s)     v̂_i");
     for (i, t) in r.hit_times.iter().enumerate() {
@@ -224,21 +285,4 @@ pub fn run(args: Args) -> anyhow::Result<()> {
             e.initial, e.kinetic, e.potential, e.impacts, e.friction, e.projection, e.frozen, e.residual
         );
     }
-    println!(
-        "impacts {} ({} plastic fallbacks), max penetration {:.3e} m, blocks turning back: {:?}, simulated {:.4} s in {:.3} s ({} steps)",
-        r.impacts,
-        r.impact_fallbacks,
-        r.max_penetration.unwrap_or(0.0),
-        r.reversed_blocks,
-        r.simulated_time,
-        r.run_time,
-        out.steps
-    );
-    for s in &r.series {
-        println!("# series block {}: t, θ, θ̇", s.block);
-        for k in 0..s.time.len() {
-            println!("{:.6} {:.6} {:.6}", s.time[k], s.theta[k], s.theta_dot[k]);
-        }
-    }
-    Ok(())
 }

@@ -18,6 +18,7 @@
 //! speculative (still open) contact points, which would otherwise stop an
 //! approaching pair inelastically at the instant of touching.
 
+pub mod chain;
 mod group;
 mod hooks;
 mod material;

@@ -1,0 +1,59 @@
+//! `topple chain --engine rapier|rapier-native` reports with the reference
+//! engine's JSON keys (issue 5), and bad engine arguments are errors.
+
+use std::process::Command;
+
+fn chain(engine: &str, extra: &[&str]) -> std::process::Output {
+    Command::new(env!("CARGO_BIN_EXE_topple"))
+        .args([
+            "chain",
+            "--preset",
+            "t",
+            "--ideal",
+            "--spacing-ratio",
+            "0.35",
+            "--n",
+            "12",
+            "--push",
+            "1.0",
+            "--engine",
+            engine,
+            "--dt",
+            "5e-4",
+            "--json",
+        ])
+        .args(extra)
+        .output()
+        .unwrap()
+}
+
+#[test]
+fn rapier_engines_report_the_reference_keys() {
+    for engine in ["rapier", "rapier-native"] {
+        let out = chain(engine, &[]);
+        assert!(
+            out.status.success(),
+            "{engine}: {}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+        assert_eq!(v["engine"].as_str().unwrap(), engine);
+        let hits = v["hit_times"].as_array().unwrap();
+        assert_eq!(hits.len(), 12, "{engine}: every block is hit");
+        // hit times increase along the row
+        let t: Vec<f64> = hits.iter().map(|x| x.as_f64().unwrap()).collect();
+        assert!(t.windows(2).all(|w| w[1] > w[0]));
+        assert!(v["speeds"].as_array().unwrap().len() >= 10);
+        // 12 blocks: v̂_na over blocks 7.. exists and is near the cooperative
+        // model's 1.8023 (Domino T, s/h 0.35; rapier-notes.md) within 10 %
+        let na = v["natural_speed"].as_f64().unwrap();
+        assert!((na - 1.8023).abs() < 0.18, "{engine}: {na}");
+    }
+}
+
+#[test]
+fn a_bad_time_step_is_an_error() {
+    let out = chain("rapier", &["--dt", "0"]);
+    assert!(!out.status.success());
+    assert!(out.stdout.is_empty());
+}
