@@ -1,0 +1,41 @@
+//! Domino X with Table 1's parameters (issue 5): the natural speed of the row
+//! run through Rapier with topple's impacts against the paper's model (the
+//! reference engine), which shares only the resolver and the presets with it.
+//! Native Rapier's result is printed for the record.
+
+use topple::domino::{Preset, RowSpec};
+use topple::rapier::chain::run_row;
+use topple::rapier::scene::{Engine, SolverSpec};
+use topple::reference::{Integrator, Settings};
+
+#[test]
+fn domino_x_table1_natural_speed_within_5_percent_of_the_reference_engine() {
+    let p = Preset::X.params();
+    let row = RowSpec::new(p, 0.35 * p.block.height, 30, 1.0);
+    let reference = topple::reference::run(
+        &row,
+        &Settings {
+            integrator: Integrator::Paper { dt: 2e-4 },
+            ..Settings::default()
+        },
+    )
+    .unwrap();
+    let expected = reference.report.natural_speed.unwrap();
+    let solver = SolverSpec {
+        dt: 2e-4,
+        max_group_hops: Some(8),
+        ..SolverSpec::default()
+    };
+    let topple = run_row(&row, Engine::Rapier, solver.clone(), 20.0).unwrap();
+    let native = run_row(&row, Engine::RapierNative, solver, 20.0).unwrap();
+    let got = topple.natural_speed.unwrap();
+    eprintln!(
+        "Domino X, Table 1, s/h 0.35, 30 blocks: reference {expected:.4}, topple {got:.4} ({:+.1}%), native Rapier {:?}",
+        100.0 * (got / expected - 1.0),
+        native.natural_speed
+    );
+    assert!(
+        (got / expected - 1.0).abs() < 0.05,
+        "topple {got} vs reference {expected}"
+    );
+}
