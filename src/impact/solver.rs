@@ -755,19 +755,16 @@ impl ImpactSolver {
                     if self.state[i].held {
                         let rate = Self::normal_rate(row, &self.velocity);
                         let wanted = (self.held_step[i] - rate / row.w_nn).max(0.0);
-                        let change = wanted - self.held_step[i];
-                        if change != 0.0 {
-                            self.held_step[i] = wanted;
-                            Self::apply(
-                                row,
-                                row.normal_axis(),
-                                change,
-                                &self.inv_mass,
-                                &self.inv_inertia,
-                                &mut self.velocity,
-                            );
-                            largest_change = largest_change.max(change.abs() * row.w_nn);
-                        }
+                        let moved = settle(
+                            row,
+                            row.normal_axis(),
+                            row.w_nn,
+                            &mut self.held_step[i],
+                            wanted,
+                            (&self.inv_mass, &self.inv_inertia),
+                            &mut self.velocity,
+                        );
+                        largest_change = largest_change.max(moved);
                     }
                     let inc = self.increment[i] + self.held_step[i];
                     if inc <= 0.0
@@ -789,19 +786,16 @@ impl ImpactSolver {
                         (wanted.signum() * row.friction * inc, false)
                     };
                     self.state[i].sticking = sticking;
-                    let change = value - self.tangent_step[i];
-                    if change != 0.0 {
-                        self.tangent_step[i] = value;
-                        Self::apply(
-                            row,
-                            row.tangent_axis(),
-                            change,
-                            &self.inv_mass,
-                            &self.inv_inertia,
-                            &mut self.velocity,
-                        );
-                        largest_change = largest_change.max(change.abs() * row.w_tt);
-                    }
+                    let moved = settle(
+                        row,
+                        row.tangent_axis(),
+                        row.w_tt,
+                        &mut self.tangent_step[i],
+                        value,
+                        (&self.inv_mass, &self.inv_inertia),
+                        &mut self.velocity,
+                    );
+                    largest_change = largest_change.max(moved);
                 }
                 if largest_change <= settled {
                     break;
@@ -962,6 +956,27 @@ fn apply_increments(
             ImpactSolver::apply(row, row.normal_axis(), p, inv_mass, inv_inertia, v);
         }
     }
+}
+
+/// Sets a step's accumulated impulse along `axis` to `wanted`, applies the
+/// difference to the bodies and returns the velocity correction it made
+/// (|change| · W along the axis, m/s).
+fn settle(
+    row: &Row,
+    axis: Axis,
+    w: f64,
+    accumulated: &mut f64,
+    wanted: f64,
+    (inv_mass, inv_inertia): (&[f64], &[f64]),
+    v: &mut [[f64; 3]],
+) -> f64 {
+    let change = wanted - *accumulated;
+    if change == 0.0 {
+        return 0.0;
+    }
+    *accumulated = wanted;
+    ImpactSolver::apply(row, axis, change, inv_mass, inv_inertia, v);
+    change.abs() * w
 }
 
 /// Smallest root in (0, 1] of a σ² + b σ + c with c < 0 < a + b + c.

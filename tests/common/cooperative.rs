@@ -121,16 +121,3 @@ fn oracle_reproduces_the_published_values() {
         assert!((got - v).abs() < 1e-3 * v, "s/h {sh}: {got} vs {v}");
     }
 }
-
-#[test]
-#[ignore]
-fn print_domino_t_values() {
-    for k in 0..11 {
-        let sh = 0.1 + 0.05 * k as f64;
-        println!(
-            "{sh:.2} {:.4} {:.4}",
-            cooperative_speed(0.08, 0.0096, sh * 0.08, 0.0),
-            cooperative_speed(0.08, 0.0096, sh * 0.08, 0.15)
-        );
-    }
-}
