@@ -114,3 +114,21 @@ fn accurate_and_paper_integrations_agree() {
     let e = accurate.energy.unwrap();
     assert!(e.residual.abs() < 1e-8 * e.initial, "{e:?}");
 }
+
+// The oracle itself against published values (kept here, in the one test
+// file that uses it, so that it runs once).
+#[test]
+fn oracle_reproduces_the_published_values() {
+    // theory.md: h 48 mm, d 7.5 mm, λ 16 mm: 1.380 m/s (μ = 0), 1.023 m/s (μ = 0.2)
+    let (h, d, lam) = (0.048, 0.0075, 0.016);
+    let vbar = (9.81f64 * h).sqrt();
+    let v0 = cooperative_speed(h, d, lam - d, 0.0) * vbar * (9.8f64 / 9.81).sqrt();
+    let v2 = cooperative_speed(h, d, lam - d, 0.2) * vbar * (9.8f64 / 9.81).sqrt();
+    assert!((v0 - 1.380).abs() < 0.002, "{v0}");
+    assert!((v2 - 1.023).abs() < 0.002, "{v2}");
+    // rapier-notes.md: Domino T
+    for (sh, v) in [(0.2, 1.9626), (0.35, 1.8023), (0.5, 1.7095)] {
+        let got = cooperative_speed(0.08, 0.0096, sh * 0.08, 0.0);
+        assert!((got - v).abs() < 1e-3 * v, "s/h {sh}: {got} vs {v}");
+    }
+}
