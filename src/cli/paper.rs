@@ -8,9 +8,12 @@ use anyhow::Context;
 use indicatif::{ProgressBar, ProgressStyle};
 use rayon::prelude::*;
 
-use super::plot::{csv, plot, Curve};
+use super::plot::{csv, plot, plot_legend_at, Curve, Style, COLOURS};
+use plotters::chart::SeriesLabelPosition;
+use plotters::style::RGBColor;
 use topple::domino::{ChainReport, Preset, RowParams, RowSpec};
 use topple::reference::{run, snapshot_svg, Integrator, Settings};
+use topple::theory::{self, Model};
 
 /// Arguments of `topple paper`.
 #[derive(clap::Args, Debug)]
@@ -64,6 +67,40 @@ fn set_mu2(mut p: RowParams, mu: f64) -> RowParams {
     p.mu2 = mu;
     p.mu2_stick = mu;
     p
+}
+
+/// A theory line of Figs. 4 and 5 (`crate::theory`).
+struct TheoryLine {
+    name: String,
+    thickness_ratio: f64,
+    model: Model,
+    style: Style,
+    colour: RGBColor,
+}
+
+fn thickness_ratio(p: Preset) -> f64 {
+    let b = p.params().block;
+    b.thickness / b.height
+}
+
+/// Spacings of a theory line: every 0.005 across the simulated spacings, and
+/// the simulated spacings themselves (so that the CSV holds the theory at each
+/// simulation point).
+fn theory_grid(xs: &[f64]) -> Vec<f64> {
+    let lo = xs.iter().cloned().fold(f64::INFINITY, f64::min);
+    let hi = xs.iter().cloned().fold(f64::NEG_INFINITY, f64::max);
+    if !(lo.is_finite() && hi.is_finite()) {
+        return Vec::new();
+    }
+    let steps = ((hi - lo) / 0.005).round() as usize;
+    let mut g: Vec<f64> = (0..=steps)
+        .map(|k| ((lo + (hi - lo) * k as f64 / steps.max(1) as f64) * 1e9).round() / 1e9)
+        .collect();
+    g.extend_from_slice(xs);
+    g.retain(|x| *x > 0.0);
+    g.sort_by(|a, b| a.total_cmp(b));
+    g.dedup_by(|a, b| (*a - *b).abs() < 1e-12);
+    g
 }
 
 fn natural(r: &ChainReport) -> f64 {
@@ -286,7 +323,8 @@ pub fn run_cmd(args: Args) -> anyhow::Result<()> {
             curves.push(Curve {
                 name: j.key.clone(),
                 points: pts,
-                markers: true,
+                style: Style::Markers,
+                colour: None,
             });
         }
         csv(
@@ -308,14 +346,21 @@ pub fn run_cmd(args: Args) -> anyhow::Result<()> {
     if want(8) {
         along(8, "Fig. 8: Domino X, s/h = 0.52, pushes 0.5/1.0/1.8")?;
     }
-    // sweeps (Figs. 4, 5, 9, 10)
-    let sweep = |fig: u32, sub: &str, title: &str, xl: &str| -> anyhow::Result<()> {
+    // sweeps (Figs. 4, 5, 9, 10); theory lines (Figs. 4, 5) after the simulations
+    let sweep = |fig: u32,
+                 sub: &str,
+                 title: &str,
+                 xl: &str,
+                 lines: &[TheoryLine],
+                 legend: SeriesLabelPosition|
+     -> anyhow::Result<()> {
         let v: Vec<(&Job, &ChainReport)> = pick(fig)
             .into_iter()
             .filter(|(j, _)| sub.is_empty() || j.key.starts_with(sub))
             .collect();
         let mut rows = Vec::new();
         let mut curves = Vec::new();
+        let mut names = keys(&v);
         for (ki, k) in keys(&v).iter().enumerate() {
             let pts: Vec<(f64, f64)> = v
                 .iter()
@@ -334,27 +379,149 @@ pub fn run_cmd(args: Args) -> anyhow::Result<()> {
             curves.push(Curve {
                 name: k.trim_start_matches(sub).trim().to_string(),
                 points: pts,
-                markers: false,
+                // with theory lines the simulations are points; alone, the
+                // points of a parameter sweep are joined to show the trend
+                style: if lines.is_empty() {
+                    Style::MarkersLine
+                } else {
+                    Style::Markers
+                },
+                colour: None,
+            });
+        }
+        let grid = theory_grid(&v.iter().map(|(j, _)| j.x).collect::<Vec<_>>());
+        for line in lines {
+            let ki = names.len();
+            names.push(format!("theory {}", line.name));
+            let sweep = theory::sweep(&[line.model], line.thickness_ratio, &grid)
+                .map_err(|e| anyhow::anyhow!("fig {fig} theory {}: {e}", line.name))?;
+            let pts: Vec<(f64, f64)> = sweep
+                .iter()
+                .map(|r| {
+                    let y = r.outcomes[0].natural_speed().unwrap_or(f64::NAN);
+                    (r.spacing_ratio, y)
+                })
+                .collect();
+            // no wave: no row in the CSV, a gap in the line
+            for (xv, yv) in pts.iter().filter(|p| p.1.is_finite()) {
+                rows.push(vec![ki as f64, *xv, *yv, f64::NAN]);
+            }
+            curves.push(Curve {
+                name: line.name.clone(),
+                points: pts,
+                style: line.style,
+                colour: Some(line.colour),
             });
         }
         let name = format!("fig{fig}{sub}");
-        let header = format!("curve({}),x,v_na,v_na_std", keys(&v).join("|"));
+        let header = format!("curve({}),x,v_na,v_na_std", names.join("|"));
         csv(&out.join(format!("{name}.csv")), &header, &rows)?;
-        plot(&out.join(format!("{name}.svg")), title, xl, "v̂_na", &curves)
+        plot_legend_at(
+            &out.join(format!("{name}.svg")),
+            title,
+            xl,
+            "v̂_na",
+            &curves,
+            legend,
+        )
     };
     if want(4) {
-        sweep(4, "", "Fig. 4: Domino T and P, Table 1", "s/h")?;
+        // Fig. 4: Stronge's cooperative group model for T (solid) and P (dot-dash)
+        let lines: Vec<TheoryLine> = [
+            ("T", Preset::T, Style::Line),
+            ("P", Preset::P, Style::DotDash),
+        ]
+        .into_iter()
+        .enumerate()
+        .map(|(k, (name, pr, style))| TheoryLine {
+            name: format!("cooperative, {name}"),
+            thickness_ratio: thickness_ratio(pr),
+            model: Model::Cooperative,
+            style,
+            colour: COLOURS[k],
+        })
+        .collect();
+        sweep(
+            4,
+            "",
+            "Fig. 4: Domino T and P, Table 1",
+            "s/h",
+            &lines,
+            SeriesLabelPosition::LowerLeft,
+        )?;
     }
     if want(5) {
-        sweep(5, "", "Fig. 5: Domino T, mu2 = 0.9, e2 = 0", "s/h")?;
+        // Fig. 5: cooperative (solid), extended with Table 1's μ1 (dash),
+        // single collision with Table 1's μ1 and e1 (dot-dash; the paper does
+        // not state the values it used)
+        let t = Preset::T.params();
+        let lines = [
+            TheoryLine {
+                name: "cooperative (mu = 0)".into(),
+                thickness_ratio: thickness_ratio(Preset::T),
+                model: Model::Cooperative,
+                style: Style::Line,
+                colour: COLOURS[5],
+            },
+            TheoryLine {
+                name: format!("extended (mu = {})", t.mu1),
+                thickness_ratio: thickness_ratio(Preset::T),
+                model: Model::Extended { mu: t.mu1 },
+                style: Style::Dashed,
+                colour: COLOURS[1],
+            },
+            TheoryLine {
+                name: format!("single (mu = {}, e = {})", t.mu1, t.e1),
+                thickness_ratio: thickness_ratio(Preset::T),
+                model: Model::Single { mu: t.mu1, e: t.e1 },
+                style: Style::DotDash,
+                colour: COLOURS[2],
+            },
+        ];
+        sweep(
+            5,
+            "",
+            "Fig. 5: Domino T, mu2 = 0.9, e2 = 0",
+            "s/h",
+            &lines,
+            SeriesLabelPosition::LowerLeft,
+        )?;
     }
     if want(9) {
-        sweep(9, "a", "Fig. 9a: X, mu2 = 0.9, e1 = e2 = 0", "mu1")?;
-        sweep(9, "b", "Fig. 9b: X, mu2 = 0.9, mu1 = e2 = 0", "e1")?;
+        sweep(
+            9,
+            "a",
+            "Fig. 9a: X, mu2 = 0.9, e1 = e2 = 0",
+            "mu1",
+            &[],
+            SeriesLabelPosition::UpperRight,
+        )?;
+        sweep(
+            9,
+            "b",
+            "Fig. 9b: X, mu2 = 0.9, mu1 = e2 = 0",
+            "e1",
+            &[],
+            SeriesLabelPosition::UpperRight,
+        )?;
     }
     if want(10) {
-        sweep(10, "a", "Fig. 10a: X, mu1 = e1 = e2 = 0", "mu2")?;
-        sweep(10, "b", "Fig. 10b: X, mu2 = 0.9, mu1 = e1 = 0", "e2")?;
+        sweep(
+            10,
+            "a",
+            "Fig. 10a: X, mu1 = e1 = e2 = 0",
+            "mu2",
+            &[],
+            SeriesLabelPosition::UpperRight,
+        )?;
+        sweep(
+            10,
+            "b",
+            "Fig. 10b: X, mu2 = 0.9, mu1 = e1 = 0",
+            "e2",
+            &[],
+            SeriesLabelPosition::UpperRight,
+        )?;
     }
     if want(7) || want(6) {
         let v = pick(7);
@@ -377,7 +544,8 @@ pub fn run_cmd(args: Args) -> anyhow::Result<()> {
                 curves.push(Curve {
                     name: format!("block {}", s.block),
                     points: pts,
-                    markers: false,
+                    style: Style::Line,
+                    colour: None,
                 });
             }
             let tag = if j.key == "ideal" { "b" } else { "a" };

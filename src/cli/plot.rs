@@ -11,11 +11,35 @@ pub struct Curve {
     pub name: String,
     /// (x, y) points.
     pub points: Vec<(f64, f64)>,
-    /// Draw markers (true) or a line (false).
-    pub markers: bool,
+    /// How the curve is drawn.
+    pub style: Style,
+    /// Colour; by default the curve's place in the palette.
+    pub colour: Option<RGBColor>,
 }
 
-const COLOURS: [RGBColor; 6] = [
+/// How a curve is drawn: simulation points as markers, theory as lines
+/// (solid, dashed, or short dashes for the paper's dot-dash lines).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Style {
+    /// Filled circles at the points.
+    Markers,
+    /// Filled circles joined by a thin line.
+    MarkersLine,
+    /// A solid line.
+    Line,
+    /// A dashed line.
+    Dashed,
+    /// A line of short dashes (the paper's dot-dash lines).
+    DotDash,
+}
+
+impl Style {
+    fn is_line(self) -> bool {
+        matches!(self, Style::Line | Style::Dashed | Style::DotDash)
+    }
+}
+
+pub const COLOURS: [RGBColor; 6] = [
     RGBColor(200, 30, 30),
     RGBColor(30, 60, 200),
     RGBColor(20, 140, 40),
@@ -24,13 +48,32 @@ const COLOURS: [RGBColor; 6] = [
     RGBColor(0, 0, 0),
 ];
 
-/// Writes an SVG plot of the curves.
+/// Writes an SVG plot of the curves, legend at the upper right.
 pub fn plot(
     path: &Path,
     title: &str,
     xlabel: &str,
     ylabel: &str,
     curves: &[Curve],
+) -> anyhow::Result<()> {
+    plot_legend_at(
+        path,
+        title,
+        xlabel,
+        ylabel,
+        curves,
+        SeriesLabelPosition::UpperRight,
+    )
+}
+
+/// Writes an SVG plot of the curves with the legend at `legend`.
+pub fn plot_legend_at(
+    path: &Path,
+    title: &str,
+    xlabel: &str,
+    ylabel: &str,
+    curves: &[Curve],
+    legend: SeriesLabelPosition,
 ) -> anyhow::Result<()> {
     let pts = curves
         .iter()
@@ -69,38 +112,74 @@ pub fn plot(
         .draw()
         .map_err(|e| anyhow::anyhow!("{e}"))?;
     for (k, c) in curves.iter().enumerate() {
-        let col = COLOURS[k % COLOURS.len()];
-        let pts: Vec<(f64, f64)> = c
-            .points
-            .iter()
-            .cloned()
-            .filter(|p| p.0.is_finite() && p.1.is_finite())
-            .collect();
-        if c.markers {
-            chart
-                .draw_series(pts.iter().map(|&p| Circle::new(p, 3, col.filled())))
-                .map_err(|e| anyhow::anyhow!("{e}"))?
-                .label(c.name.clone())
-                .legend(move |(x, y)| Circle::new((x + 10, y), 3, col.filled()));
+        let col = c.colour.unwrap_or(COLOURS[k % COLOURS.len()]);
+        // contiguous runs of finite points: a non-finite y (no value) breaks a line
+        let mut segments: Vec<Vec<(f64, f64)>> = vec![Vec::new()];
+        for &p in &c.points {
+            if p.0.is_finite() && p.1.is_finite() {
+                segments.last_mut().expect("non-empty").push(p);
+            } else if !segments.last().expect("non-empty").is_empty() {
+                segments.push(Vec::new());
+            }
+        }
+        segments.retain(|s| !s.is_empty());
+        let pts: Vec<(f64, f64)> = segments.iter().flatten().cloned().collect();
+        let line = col.stroke_width(2);
+        let thin = col.stroke_width(1);
+        let mut labelled = false;
+        if c.style.is_line() {
+            for seg in segments {
+                let anno = match c.style {
+                    Style::Dashed => chart.draw_series(DashedLineSeries::new(seg, 10, 6, line)),
+                    Style::DotDash => chart.draw_series(DashedLineSeries::new(seg, 3, 5, line)),
+                    _ => chart.draw_series(LineSeries::new(seg, line)),
+                }
+                .map_err(|e| anyhow::anyhow!("{e}"))?;
+                if !labelled {
+                    labelled = true;
+                    label_series(anno, &c.name, c.style, col);
+                }
+            }
         } else {
-            chart
-                .draw_series(LineSeries::new(pts, col.stroke_width(2)))
-                .map_err(|e| anyhow::anyhow!("{e}"))?
-                .label(c.name.clone())
-                .legend(move |(x, y)| {
-                    PathElement::new(vec![(x, y), (x + 20, y)], col.stroke_width(2))
-                });
+            if c.style == Style::MarkersLine {
+                for seg in &segments {
+                    chart
+                        .draw_series(LineSeries::new(seg.clone(), thin))
+                        .map_err(|e| anyhow::anyhow!("{e}"))?;
+                }
+            }
+            let anno = chart
+                .draw_series(pts.iter().map(|&p| Circle::new(p, 3, col.filled())))
+                .map_err(|e| anyhow::anyhow!("{e}"))?;
+            label_series(anno, &c.name, c.style, col);
         }
     }
     chart
         .configure_series_labels()
         .background_style(WHITE.mix(0.8))
         .border_style(BLACK)
-        .position(SeriesLabelPosition::UpperRight)
+        .position(legend)
         .draw()
         .map_err(|e| anyhow::anyhow!("{e}"))?;
     root.present().map_err(|e| anyhow::anyhow!("{e}"))?;
     Ok(())
+}
+
+/// Labels a series in the legend with a line or a marker, as it is drawn.
+fn label_series<'a, DB: DrawingBackend + 'a>(
+    anno: &mut plotters::chart::SeriesAnno<'a, DB>,
+    name: &str,
+    style: Style,
+    col: RGBColor,
+) {
+    let line = col.stroke_width(2);
+    anno.label(name).legend(move |(x, y)| {
+        if style.is_line() {
+            PathElement::new(vec![(x, y), (x + 20, y)], line).into_dyn()
+        } else {
+            Circle::new((x + 10, y), 3, col.filled()).into_dyn()
+        }
+    });
 }
 
 /// Writes a CSV file: a header line and rows.
