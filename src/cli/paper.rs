@@ -8,8 +8,7 @@ use anyhow::Context;
 use indicatif::{ProgressBar, ProgressStyle};
 use rayon::prelude::*;
 
-use super::plot::{csv, plot, plot_legend_at, Curve, Style, COLOURS};
-use plotters::chart::SeriesLabelPosition;
+use super::plot::{csv, plot, Curve, Style, COLOURS};
 use plotters::style::RGBColor;
 use topple::domino::{ChainReport, Preset, RowParams, RowSpec};
 use topple::reference::{run, snapshot_svg, Integrator, Settings};
@@ -123,7 +122,7 @@ pub fn run_cmd(args: Args) -> anyhow::Result<()> {
     let mut jobs: Vec<Job> = Vec::new();
     let x = Preset::X.params();
     let spacings: Vec<f64> = if args.spacings.is_empty() {
-        (0..11).map(|k| 0.1 + 0.05 * k as f64).collect()
+        (0..11).map(|k| (1.0 + 0.5 * k as f64) / 10.0).collect()
     } else {
         args.spacings.clone()
     };
@@ -347,84 +346,72 @@ pub fn run_cmd(args: Args) -> anyhow::Result<()> {
         along(8, "Fig. 8: Domino X, s/h = 0.52, pushes 0.5/1.0/1.8")?;
     }
     // sweeps (Figs. 4, 5, 9, 10); theory lines (Figs. 4, 5) after the simulations
-    let sweep = |fig: u32,
-                 sub: &str,
-                 title: &str,
-                 xl: &str,
-                 lines: &[TheoryLine],
-                 legend: SeriesLabelPosition|
-     -> anyhow::Result<()> {
-        let v: Vec<(&Job, &ChainReport)> = pick(fig)
-            .into_iter()
-            .filter(|(j, _)| sub.is_empty() || j.key.starts_with(sub))
-            .collect();
-        let mut rows = Vec::new();
-        let mut curves = Vec::new();
-        let mut names = keys(&v);
-        for (ki, k) in keys(&v).iter().enumerate() {
-            let pts: Vec<(f64, f64)> = v
-                .iter()
-                .filter(|(j, _)| &j.key == k)
-                .map(|(j, r)| (j.x, natural(r)))
+    let sweep =
+        |fig: u32, sub: &str, title: &str, xl: &str, lines: &[TheoryLine]| -> anyhow::Result<()> {
+            let v: Vec<(&Job, &ChainReport)> = pick(fig)
+                .into_iter()
+                .filter(|(j, _)| sub.is_empty() || j.key.starts_with(sub))
                 .collect();
-            for (xv, yv) in &pts {
-                let spread = v
+            let mut rows = Vec::new();
+            let mut curves = Vec::new();
+            let mut names = keys(&v);
+            for (ki, k) in keys(&v).iter().enumerate() {
+                let pts: Vec<(f64, f64)> = v
                     .iter()
-                    .find(|(j, _)| &j.key == k && j.x == *xv)
-                    .and_then(|(_, r)| r.natural_speed_spread)
-                    .map(|s| s.std_dev)
-                    .unwrap_or(f64::NAN);
-                rows.push(vec![ki as f64, *xv, *yv, spread]);
+                    .filter(|(j, _)| &j.key == k)
+                    .map(|(j, r)| (j.x, natural(r)))
+                    .collect();
+                for (xv, yv) in &pts {
+                    let spread = v
+                        .iter()
+                        .find(|(j, _)| &j.key == k && j.x == *xv)
+                        .and_then(|(_, r)| r.natural_speed_spread)
+                        .map(|s| s.std_dev)
+                        .unwrap_or(f64::NAN);
+                    rows.push(vec![ki as f64, *xv, *yv, spread]);
+                }
+                curves.push(Curve {
+                    name: k.trim_start_matches(sub).trim().to_string(),
+                    points: pts,
+                    // with theory lines the simulations are points; alone, the
+                    // points of a parameter sweep are joined to show the trend
+                    style: if lines.is_empty() {
+                        Style::MarkersLine
+                    } else {
+                        Style::Markers
+                    },
+                    colour: None,
+                });
             }
-            curves.push(Curve {
-                name: k.trim_start_matches(sub).trim().to_string(),
-                points: pts,
-                // with theory lines the simulations are points; alone, the
-                // points of a parameter sweep are joined to show the trend
-                style: if lines.is_empty() {
-                    Style::MarkersLine
-                } else {
-                    Style::Markers
-                },
-                colour: None,
-            });
-        }
-        let grid = theory_grid(&v.iter().map(|(j, _)| j.x).collect::<Vec<_>>());
-        for line in lines {
-            let ki = names.len();
-            names.push(format!("theory {}", line.name));
-            let sweep = theory::sweep(&[line.model], line.thickness_ratio, &grid)
-                .map_err(|e| anyhow::anyhow!("fig {fig} theory {}: {e}", line.name))?;
-            let pts: Vec<(f64, f64)> = sweep
-                .iter()
-                .map(|r| {
-                    let y = r.outcomes[0].natural_speed().unwrap_or(f64::NAN);
-                    (r.spacing_ratio, y)
-                })
-                .collect();
-            // no wave: no row in the CSV, a gap in the line
-            for (xv, yv) in pts.iter().filter(|p| p.1.is_finite()) {
-                rows.push(vec![ki as f64, *xv, *yv, f64::NAN]);
+            let grid = theory_grid(&v.iter().map(|(j, _)| j.x).collect::<Vec<_>>());
+            for line in lines {
+                let ki = names.len();
+                names.push(format!("theory {}", line.name));
+                let sweep = theory::sweep(&[line.model], line.thickness_ratio, &grid)
+                    .map_err(|e| anyhow::anyhow!("fig {fig} theory {}: {e}", line.name))?;
+                let pts: Vec<(f64, f64)> = sweep
+                    .iter()
+                    .map(|r| {
+                        let y = r.outcomes[0].natural_speed().unwrap_or(f64::NAN);
+                        (r.spacing_ratio, y)
+                    })
+                    .collect();
+                // no wave: no row in the CSV, a gap in the line
+                for (xv, yv) in pts.iter().filter(|p| p.1.is_finite()) {
+                    rows.push(vec![ki as f64, *xv, *yv, f64::NAN]);
+                }
+                curves.push(Curve {
+                    name: line.name.clone(),
+                    points: pts,
+                    style: line.style,
+                    colour: Some(line.colour),
+                });
             }
-            curves.push(Curve {
-                name: line.name.clone(),
-                points: pts,
-                style: line.style,
-                colour: Some(line.colour),
-            });
-        }
-        let name = format!("fig{fig}{sub}");
-        let header = format!("curve({}),x,v_na,v_na_std", names.join("|"));
-        csv(&out.join(format!("{name}.csv")), &header, &rows)?;
-        plot_legend_at(
-            &out.join(format!("{name}.svg")),
-            title,
-            xl,
-            "v̂_na",
-            &curves,
-            legend,
-        )
-    };
+            let name = format!("fig{fig}{sub}");
+            let header = format!("curve({}),x,v_na,v_na_std", names.join("|"));
+            csv(&out.join(format!("{name}.csv")), &header, &rows)?;
+            plot(&out.join(format!("{name}.svg")), title, xl, "v̂_na", &curves)
+        };
     if want(4) {
         // Fig. 4: Stronge's cooperative group model for T (solid) and P (dot-dash)
         let lines: Vec<TheoryLine> = [
@@ -441,14 +428,7 @@ pub fn run_cmd(args: Args) -> anyhow::Result<()> {
             colour: COLOURS[k],
         })
         .collect();
-        sweep(
-            4,
-            "",
-            "Fig. 4: Domino T and P, Table 1",
-            "s/h",
-            &lines,
-            SeriesLabelPosition::LowerLeft,
-        )?;
+        sweep(4, "", "Fig. 4: Domino T and P, Table 1", "s/h", &lines)?;
     }
     if want(5) {
         // Fig. 5: cooperative (solid), extended with Table 1's μ1 (dash),
@@ -478,50 +458,15 @@ pub fn run_cmd(args: Args) -> anyhow::Result<()> {
                 colour: COLOURS[2],
             },
         ];
-        sweep(
-            5,
-            "",
-            "Fig. 5: Domino T, mu2 = 0.9, e2 = 0",
-            "s/h",
-            &lines,
-            SeriesLabelPosition::LowerLeft,
-        )?;
+        sweep(5, "", "Fig. 5: Domino T, mu2 = 0.9, e2 = 0", "s/h", &lines)?;
     }
     if want(9) {
-        sweep(
-            9,
-            "a",
-            "Fig. 9a: X, mu2 = 0.9, e1 = e2 = 0",
-            "mu1",
-            &[],
-            SeriesLabelPosition::UpperRight,
-        )?;
-        sweep(
-            9,
-            "b",
-            "Fig. 9b: X, mu2 = 0.9, mu1 = e2 = 0",
-            "e1",
-            &[],
-            SeriesLabelPosition::UpperRight,
-        )?;
+        sweep(9, "a", "Fig. 9a: X, mu2 = 0.9, e1 = e2 = 0", "mu1", &[])?;
+        sweep(9, "b", "Fig. 9b: X, mu2 = 0.9, mu1 = e2 = 0", "e1", &[])?;
     }
     if want(10) {
-        sweep(
-            10,
-            "a",
-            "Fig. 10a: X, mu1 = e1 = e2 = 0",
-            "mu2",
-            &[],
-            SeriesLabelPosition::UpperRight,
-        )?;
-        sweep(
-            10,
-            "b",
-            "Fig. 10b: X, mu2 = 0.9, mu1 = e1 = 0",
-            "e2",
-            &[],
-            SeriesLabelPosition::UpperRight,
-        )?;
+        sweep(10, "a", "Fig. 10a: X, mu1 = e1 = e2 = 0", "mu2", &[])?;
+        sweep(10, "b", "Fig. 10b: X, mu2 = 0.9, mu1 = e1 = 0", "e2", &[])?;
     }
     if want(7) || want(6) {
         let v = pick(7);

@@ -48,32 +48,14 @@ pub const COLOURS: [RGBColor; 6] = [
     RGBColor(0, 0, 0),
 ];
 
-/// Writes an SVG plot of the curves, legend at the upper right.
+/// Writes an SVG plot of the curves, the legend in a corner free of points
+/// (upper right above the data when no corner is free).
 pub fn plot(
     path: &Path,
     title: &str,
     xlabel: &str,
     ylabel: &str,
     curves: &[Curve],
-) -> anyhow::Result<()> {
-    plot_legend_at(
-        path,
-        title,
-        xlabel,
-        ylabel,
-        curves,
-        SeriesLabelPosition::UpperRight,
-    )
-}
-
-/// Writes an SVG plot of the curves with the legend at `legend`.
-pub fn plot_legend_at(
-    path: &Path,
-    title: &str,
-    xlabel: &str,
-    ylabel: &str,
-    curves: &[Curve],
-    legend: SeriesLabelPosition,
 ) -> anyhow::Result<()> {
     let pts = curves
         .iter()
@@ -95,7 +77,51 @@ pub fn plot_legend_at(
         (x0, x1, y0, y1) = (0.0, 1.0, 0.0, 1.0);
     }
     let dx = (x1 - x0).max(1e-9) * 0.05;
-    let dy = (y1 - y0).max(1e-9) * 0.08;
+    let mut dy = (y1 - y0).max(1e-9) * 0.08;
+    let (xa, xb, ya, yb) = (x0 - dx, x1 + dx, y0 - dy, y1 + dy);
+    // the legend box as fractions of the plotting area (~650 x 390 px)
+    let width = curves
+        .iter()
+        .map(|c| c.name.chars().count())
+        .max()
+        .unwrap_or(0) as f64;
+    let (fw, fh) = (
+        (40.0 + 7.0 * width) / 650.0,
+        (14.0 + 20.0 * curves.len() as f64) / 390.0,
+    );
+    let inside = |left: bool, top: bool| -> usize {
+        let (bx0, bx1) = if left {
+            (xa, xa + fw * (xb - xa))
+        } else {
+            (xb - fw * (xb - xa), xb)
+        };
+        let (by0, by1) = if top {
+            (yb - fh * (yb - ya), yb)
+        } else {
+            (ya, ya + fh * (yb - ya))
+        };
+        curves
+            .iter()
+            .flat_map(|c| c.points.iter())
+            .filter(|p| p.0 >= bx0 && p.0 <= bx1 && p.1 >= by0 && p.1 <= by1)
+            .count()
+    };
+    let legend = {
+        let corners = [
+            (false, true, SeriesLabelPosition::UpperRight),
+            (true, true, SeriesLabelPosition::UpperLeft),
+            (false, false, SeriesLabelPosition::LowerRight),
+            (true, false, SeriesLabelPosition::LowerLeft),
+        ];
+        match corners.iter().find(|(l, t, _)| inside(*l, *t) == 0) {
+            Some((_, _, pos)) => pos.clone(),
+            None => {
+                // room above the data
+                dy += fh / (1.0 - fh) * (y1 - y0 + 2.0 * dy);
+                SeriesLabelPosition::UpperRight
+            }
+        }
+    };
     let root = SVGBackend::new(path, (720, 480)).into_drawing_area();
     root.fill(&WHITE).map_err(|e| anyhow::anyhow!("{e}"))?;
     let mut chart = ChartBuilder::on(&root)
@@ -103,7 +129,7 @@ pub fn plot_legend_at(
         .margin(12)
         .x_label_area_size(40)
         .y_label_area_size(56)
-        .build_cartesian_2d(x0 - dx..x1 + dx, y0 - dy..y1 + dy)
+        .build_cartesian_2d(x0 - dx..x1 + dx, y0 - (y1 - y0).max(1e-9) * 0.08..y1 + dy)
         .map_err(|e| anyhow::anyhow!("{e}"))?;
     chart
         .configure_mesh()
