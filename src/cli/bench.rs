@@ -277,8 +277,10 @@ fn print_table(
         baseline.map_or("nothing (no reference run)", |b| kinds[b].0.as_str())
     );
     println!();
-    println!("| run | run time (s) | blocks hit | impacts | fallbacks | ms/step | topple/native | v̂_na | spread (std) | error |");
+    println!("| run | run time (s) | blocks hit | impacts | held / plastic | ms/step | topple/native | v̂_na | spread (std) | error |");
     println!("| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |");
+    // held / plastic: impacts solved again with e = 0 contacts held, and
+    // impacts resolved as plastic (reference engine only)
     for (k, ((name, kind), r)) in kinds.iter().zip(reports).enumerate() {
         // Rapier: wall time per Rapier step; the ratio against the native run
         // at the same step from this same invocation.
@@ -304,11 +306,12 @@ fn print_table(
             _ => "-".into(),
         };
         println!(
-            "| {name} | {:.1} | {}/{} | {} | {} | {} | {ratio} | {} | {} | {error} |",
+            "| {name} | {:.1} | {}/{} | {} | {} / {} | {} | {ratio} | {} | {} | {error} |",
             r.run_time,
             r.hit_times.len(),
             row.n,
             r.impacts,
+            r.held_impacts,
             r.impact_fallbacks,
             ms_per_step.map_or("-".to_string(), |m| format!("{m:.3}")),
             r.natural_speed

@@ -264,8 +264,9 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     }
     print_report(r, args.row.spacing_ratio, &row);
     println!(
-        "impacts {} ({} plastic fallbacks), max penetration {:.3e} m, blocks turning back: {:?}, simulated {:.4} s in {:.3} s ({} steps)",
+        "impacts {} ({} with e = 0 contacts held, {} plastic fallbacks), max penetration {:.3e} m, blocks turning back: {:?}, simulated {:.4} s in {:.3} s ({} steps)",
         r.impacts,
+        r.held_impacts,
         r.impact_fallbacks,
         r.max_penetration.unwrap_or(0.0),
         r.reversed_blocks,

@@ -83,6 +83,7 @@ pub(crate) struct Engine {
     pub max_penetration: f64,
     pub impacts: usize,
     pub impact_fallbacks: usize,
+    pub held_impacts: usize,
     pub reversed: Vec<bool>,
     pub steps: usize,
     pub evaluations: usize,
@@ -171,6 +172,7 @@ impl Engine {
             max_penetration: 0.0,
             impacts: 0,
             impact_fallbacks: 0,
+            held_impacts: 0,
             reversed: vec![false; n],
             steps: 0,
             evaluations: 0,
@@ -802,6 +804,7 @@ pub fn run(row: &RowSpec, settings: &Settings) -> Result<RunResult, EngineError>
     report.impacts = e.impacts;
     report.stopped_early = stopped_early;
     report.impact_fallbacks = e.impact_fallbacks;
+    report.held_impacts = e.held_impacts;
     report.reversed_blocks = (0..row.n)
         .filter(|&i| e.reversed[i])
         .map(|i| i + 1)

@@ -43,8 +43,10 @@ pub struct Settings {
     /// Time integration of the smooth phase.
     pub integrator: Integrator,
     /// Impulse stepping of the impacts (default: the paper's ΔP = 10⁻⁴ P₀,
-    /// at most 2·10⁵ steps; an impact that needs more is resolved as plastic
-    /// and counted in [`crate::domino::ChainReport::impact_fallbacks`]).
+    /// at most 2·10⁵ steps). An impact that needs more is solved again with
+    /// its e = 0 contacts held closed (counted in
+    /// [`crate::domino::ChainReport::held_impacts`]); if that fails too it is
+    /// resolved as plastic ([`crate::domino::ChainReport::impact_fallbacks`]).
     pub impact: ImpactSettings,
     /// A contact is closed when its gap is below this fraction of h
     /// (default 10⁻⁶); also the penetration allowed before a closing event.
