@@ -133,6 +133,11 @@ pub struct Args {
     /// acceleration (fraction of g); 0 never freezes.
     #[arg(long)]
     pub freeze_tolerance: Option<f64>,
+    /// Reference engine: make the heel of every block a contact on the front
+    /// face of the block behind (no overlap where blocks slide back; stalls on
+    /// ideal rows, see README).
+    #[arg(long)]
+    pub heel_contacts: bool,
     /// Print the report as JSON.
     #[arg(long)]
     pub json: bool,
@@ -222,6 +227,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     if let Some(f) = args.freeze_tolerance {
         settings.freeze_tolerance = f;
     }
+    settings.heel_contacts = args.heel_contacts;
     settings.series_blocks = args.series.clone();
     settings.snapshot_times = args.snapshots.clone();
     let rapier_engine = match args.engine {

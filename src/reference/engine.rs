@@ -293,13 +293,13 @@ impl Engine {
             if i + 1 < self.row.n {
                 f(i, lambda + 1);
             }
-            // The heel of block i+1 on the front face of block i only for the
-            // last pair, where the last block lies on the ground: inside the
-            // row the pair converges to face-to-face contact at the rest angle,
-            // where the two corner contacts are redundant and make the contact
-            // and impact problems degenerate (the paper's model has only A_i
-            // and B_i there).
-            if i + 2 == self.row.n {
+            // The heel of block i+1 on the front face of block i: by default
+            // only for the last pair, where the last block lies on the ground.
+            // Inside the row the pair converges to face-to-face contact at the
+            // rest angle, where the two corner contacts make the contact and
+            // impact problems degenerate (the paper's model has only A_i and
+            // B_i there); `Settings::heel_contacts` turns them on everywhere.
+            if i + 2 == self.row.n || (self.s.heel_contacts && i + 1 < self.row.n) {
                 f(i, lambda + 2);
             }
         }
