@@ -41,9 +41,10 @@ pub enum EngineArg {
     RapierNative,
 }
 
-/// Arguments of `topple chain`.
-#[derive(clap::Args, Debug)]
-pub struct Args {
+/// The row: preset, spacing, length, push and material overrides (shared by
+/// `topple chain` and `topple bench`).
+#[derive(clap::Args, Debug, Clone)]
+pub struct RowArgs {
     /// Block type (Table 1).
     #[arg(long, value_enum, default_value = "x")]
     pub preset: PresetArg,
@@ -99,11 +100,21 @@ pub struct Args {
     /// Block thickness d (m).
     #[arg(long)]
     pub thickness: Option<f64>,
+}
+
+/// Arguments of `topple chain`.
+#[derive(clap::Args, Debug)]
+pub struct Args {
+    /// The row.
+    #[command(flatten)]
+    pub row: RowArgs,
     /// Engine.
     #[arg(long, value_enum, default_value = "reference")]
     pub engine: EngineArg,
-    /// Accurate integration at this tolerance (adaptive Dormand–Prince and
-    /// adaptive impacts) instead of the paper's improved Euler at 1e-4 s.
+    /// Accurate integration at this tolerance (adaptive Dormand–Prince;
+    /// impacts keep the paper's impulse step) instead of the paper's improved
+    /// Euler at --dt. With a Rapier engine: adaptive impulse stepping at this
+    /// tolerance.
     #[arg(long)]
     pub tolerance: Option<f64>,
     /// Fixed time step of the paper's integration (s); with a Rapier engine,
@@ -122,6 +133,11 @@ pub struct Args {
     /// acceleration (fraction of g); 0 never freezes.
     #[arg(long)]
     pub freeze_tolerance: Option<f64>,
+    /// Reference engine: make the heel of every block a contact on the front
+    /// face of the block behind (no overlap where blocks slide back; stalls on
+    /// ideal rows, see README).
+    #[arg(long)]
+    pub heel_contacts: bool,
     /// Print the report as JSON.
     #[arg(long)]
     pub json: bool,
@@ -137,7 +153,7 @@ pub struct Args {
 }
 
 /// Row parameters from a preset and the overrides.
-pub fn params(args: &Args) -> RowParams {
+pub fn params(args: &RowArgs) -> RowParams {
     let mut p = Preset::from(args.preset).params();
     if args.ideal {
         p = p.ideal();
@@ -186,9 +202,21 @@ pub fn params(args: &Args) -> RowParams {
     p
 }
 
+/// The row to simulate.
+pub fn row_spec(args: &RowArgs) -> anyhow::Result<RowSpec> {
+    anyhow::ensure!(args.n >= 1, "--n must be at least 1");
+    let p = params(args);
+    Ok(RowSpec::new(
+        p,
+        args.spacing_ratio * p.block.height,
+        args.n,
+        args.push,
+    ))
+}
+
 pub fn run(args: Args) -> anyhow::Result<()> {
-    let p = params(&args);
-    let row = RowSpec::new(p, args.spacing_ratio * p.block.height, args.n, args.push);
+    let p = params(&args.row);
+    let row = row_spec(&args.row)?;
     let mut settings = match args.tolerance {
         Some(tol) => Settings::accurate(tol),
         None => Settings {
@@ -199,6 +227,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     if let Some(f) = args.freeze_tolerance {
         settings.freeze_tolerance = f;
     }
+    settings.heel_contacts = args.heel_contacts;
     settings.series_blocks = args.series.clone();
     settings.snapshot_times = args.snapshots.clone();
     let rapier_engine = match args.engine {
@@ -221,7 +250,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         if args.json {
             println!("{}", serde_json::to_string_pretty(&report)?);
         } else {
-            print_report(&report, args.spacing_ratio, &row);
+            print_report(&report, args.row.spacing_ratio, &row);
             println!(
                 "impacts {}, simulated {:.4} s in {:.3} s",
                 report.impacts, report.simulated_time, report.run_time
@@ -239,10 +268,11 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         println!("{}", serde_json::to_string_pretty(r)?);
         return Ok(());
     }
-    print_report(r, args.spacing_ratio, &row);
+    print_report(r, args.row.spacing_ratio, &row);
     println!(
-        "impacts {} ({} plastic fallbacks), max penetration {:.3e} m, blocks turning back: {:?}, simulated {:.4} s in {:.3} s ({} steps)",
+        "impacts {} ({} with e = 0 contacts held, {} plastic fallbacks), max penetration {:.3e} m, blocks turning back: {:?}, simulated {:.4} s in {:.3} s ({} steps)",
         r.impacts,
+        r.held_impacts,
         r.impact_fallbacks,
         r.max_penetration.unwrap_or(0.0),
         r.reversed_blocks,

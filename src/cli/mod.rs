@@ -4,6 +4,7 @@
 
 use clap::{Parser, Subcommand};
 
+mod bench;
 mod chain;
 mod impact;
 mod paper;
@@ -36,6 +37,8 @@ enum Command {
     Chain(chain::Args),
     /// Regenerate the paper's Figs. 3–10 (CSV + SVG) with the reference engine.
     Paper(paper::Args),
+    /// Run time against accuracy of one row over engines and settings (a table).
+    Bench(bench::Args),
 }
 
 /// Parses the command line, runs the subcommand, returns the exit status.
@@ -47,6 +50,7 @@ pub fn run() -> i32 {
         Command::Theory(args) => theory::run(args),
         Command::Chain(args) => chain::run(args),
         Command::Paper(args) => paper::run_cmd(args),
+        Command::Bench(args) => bench::run(args),
     };
     match result {
         Ok(()) => 0,

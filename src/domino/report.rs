@@ -78,9 +78,15 @@ pub struct ChainReport {
     pub max_penetration: Option<f64>,
     /// Number of impacts resolved.
     pub impacts: usize,
-    /// Impacts the LZB resolver could not finish within its step limit,
-    /// resolved as plastic impacts instead (should be 0 or rare).
+    /// Impacts the LZB resolver could not finish within its step limit even
+    /// with e = 0 contacts held, resolved as plastic impacts instead (should
+    /// be 0 or rare).
     pub impact_fallbacks: usize,
+    /// Impacts the paper's e = 0 law could not finish within the step limit,
+    /// solved again with e = 0 contacts held closed
+    /// ([`crate::impact::ImpactSettings::e0_hold`]).
+    #[serde(default)]
+    pub held_impacts: usize,
     /// Blocks that rotated anticlockwise (θ̇ < 0) at some time, 1-based.
     pub reversed_blocks: Vec<usize>,
     /// The run hit its wall-clock limit before the wave finished.
@@ -109,6 +115,7 @@ impl ChainReport {
             max_penetration: None,
             impacts: 0,
             impact_fallbacks: 0,
+            held_impacts: 0,
             reversed_blocks: Vec::new(),
             stopped_early: false,
             simulated_time: 0.0,

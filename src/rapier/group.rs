@@ -13,7 +13,9 @@
 //! in [`crate::rapier::ToppleRapier`], later a Bevy/f32 one) only has to fill
 //! the two slices.
 
-use crate::impact::{Body, Contact, ContactMaterial, ImpactError, ImpactSettings, ImpactSolver};
+use crate::impact::{
+    Body, Contact, ContactMaterial, ImpactError, ImpactOutcome, ImpactSettings, ImpactSolver,
+};
 
 use super::patch::PatchRule;
 
@@ -151,6 +153,8 @@ pub struct ImpactGroups {
     local: Vec<usize>,
     group_bodies: Vec<Body>,
     group_contacts: Vec<Contact>,
+    /// The resolver's output, reused so that a steady scene allocates nothing.
+    outcome: ImpactOutcome,
 }
 
 #[inline]
@@ -399,10 +403,13 @@ impl ImpactGroups {
                     c.material,
                 ));
             }
-            let out = self
-                .solver
-                .solve(&self.group_bodies, &self.group_contacts, &settings.impact);
-            let out = out?;
+            self.solver.solve_into(
+                &self.group_bodies,
+                &self.group_contacts,
+                &settings.impact,
+                &mut self.outcome,
+            )?;
+            let out = &self.outcome;
             for (&i, v) in self.body_order[self.body_start[g]..self.body_start[g + 1]]
                 .iter()
                 .zip(&out.bodies)

@@ -354,12 +354,18 @@ impl ToppleRapier {
         let groups = result?;
         if groups > 0 {
             for (h, b) in self.handles.iter().zip(&self.bodies) {
-                let rb = &mut bodies[*h];
                 let (v, w) = (
                     Vector::new(b.velocity[0], b.velocity[1]),
                     b.angular_velocity,
                 );
-                if rb.linvel() != v || rb.angvel() != w {
+                // Compare through a shared borrow: `IndexMut` records the body
+                // in Rapier's modified list (work and, after each step, an
+                // allocation), which only bodies the impact changed need.
+                let unchanged = bodies
+                    .get(*h)
+                    .is_some_and(|rb| rb.linvel() == v && rb.angvel() == w);
+                if !unchanged {
+                    let rb = &mut bodies[*h];
                     rb.set_linvel(v, true);
                     rb.set_angvel(w, true);
                 }

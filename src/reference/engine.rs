@@ -83,6 +83,7 @@ pub(crate) struct Engine {
     pub max_penetration: f64,
     pub impacts: usize,
     pub impact_fallbacks: usize,
+    pub held_impacts: usize,
     pub reversed: Vec<bool>,
     pub steps: usize,
     pub evaluations: usize,
@@ -171,6 +172,7 @@ impl Engine {
             max_penetration: 0.0,
             impacts: 0,
             impact_fallbacks: 0,
+            held_impacts: 0,
             reversed: vec![false; n],
             steps: 0,
             evaluations: 0,
@@ -291,13 +293,13 @@ impl Engine {
             if i + 1 < self.row.n {
                 f(i, lambda + 1);
             }
-            // The heel of block i+1 on the front face of block i only for the
-            // last pair, where the last block lies on the ground: inside the
-            // row the pair converges to face-to-face contact at the rest angle,
-            // where the two corner contacts are redundant and make the contact
-            // and impact problems degenerate (the paper's model has only A_i
-            // and B_i there).
-            if i + 2 == self.row.n {
+            // The heel of block i+1 on the front face of block i: by default
+            // only for the last pair, where the last block lies on the ground.
+            // Inside the row the pair converges to face-to-face contact at the
+            // rest angle, where the two corner contacts make the contact and
+            // impact problems degenerate (the paper's model has only A_i and
+            // B_i there); `Settings::heel_contacts` turns them on everywhere.
+            if i + 2 == self.row.n || (self.s.heel_contacts && i + 1 < self.row.n) {
                 f(i, lambda + 2);
             }
         }
@@ -802,6 +804,7 @@ pub fn run(row: &RowSpec, settings: &Settings) -> Result<RunResult, EngineError>
     report.impacts = e.impacts;
     report.stopped_early = stopped_early;
     report.impact_fallbacks = e.impact_fallbacks;
+    report.held_impacts = e.held_impacts;
     report.reversed_blocks = (0..row.n)
         .filter(|&i| e.reversed[i])
         .map(|i| i + 1)

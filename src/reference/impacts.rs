@@ -201,12 +201,29 @@ impl Engine {
                 material: self.material(slot),
             });
         }
-        let out = match self.solver.solve(&bodies, &contacts, &self.s.impact) {
+        let step_limit = |r: &Result<_, crate::impact::ImpactError>| {
+            matches!(r, Err(crate::impact::ImpactError::StepLimit { .. }))
+        };
+        let mut result = self.solver.solve(&bodies, &contacts, &self.s.impact);
+        if step_limit(&result) && !self.s.impact.e0_hold {
+            // The paper's e = 0 law did not finish: a wedged group whose e = 0
+            // contacts release and reload in ever smaller cycles. Their limit
+            // is a contact held closed, which `e0_hold` solves directly (the
+            // e > 0 contacts keep the LZB law). Counted as a held impact.
+            let held = crate::impact::ImpactSettings {
+                e0_hold: true,
+                ..self.s.impact
+            };
+            result = self.solver.solve(&bodies, &contacts, &held);
+            if result.is_ok() {
+                self.held_impacts += 1;
+            }
+        }
+        let out = match result {
             Ok(out) => out,
-            Err(crate::impact::ImpactError::StepLimit { .. }) => {
-                // The resolver did not finish (a wedged, nearly redundant
-                // contact set): resolve this one as a plastic impact instead,
-                // the smallest velocity change (in kinetic-energy norm) that
+            Err(_) if step_limit(&result) => {
+                // Still unfinished: resolve this one as a plastic impact, the
+                // smallest velocity change (in kinetic-energy norm) that
                 // leaves no closed contact of the group approaching. Counted
                 // in the report as a fallback.
                 self.plastic_impact(&closed, &in_group);

@@ -21,8 +21,9 @@
 //!   and Dormand–Prince 5(4) with error control.
 //! - Impacts (Sec. 2.3): by [`crate::impact::ImpactSolver`], one group of
 //!   closed contacts at a time, impact friction 0.5 × Table 1 (errata §4); an
-//!   impact the resolver cannot finish within its step limit is resolved as a
-//!   plastic impact and counted (`impact_fallbacks`).
+//!   impact the resolver cannot finish within its step limit is solved again
+//!   with its e = 0 contacts held closed (`held_impacts`), and if that fails
+//!   too, as a plastic impact (`impact_fallbacks`).
 //! - Only what moves is integrated: a window of blocks lo..hi; the block in
 //!   front of the wave joins when struck, blocks at rest behind it are frozen.
 //!   The cost per step depends on the window, not on the row.

@@ -1,0 +1,371 @@
+//! `topple bench`: run time against accuracy for one domino row, over engines
+//! and their settings, measured in one invocation so that the ratios compare
+//! runs on the same machine under the same load.
+//!
+//! Each run is given as `ENGINE:SETTING…`:
+//!
+//! | run | meaning |
+//! | --- | --- |
+//! | `reference:paper` | reference engine, the paper's improved Euler at 10⁻⁴ s |
+//! | `reference:paper:DT` | the same at time step DT (s) |
+//! | `reference:TOL` | reference engine, adaptive Dormand–Prince at tolerance TOL |
+//! | `rapier:DT:STEP` | Rapier with topple, time step DT (s), fixed impulse step ΔP/P₀ = STEP |
+//! | `rapier:DT:tol:TOL` | Rapier with topple, adaptive impulse stepping at TOL |
+//! | `native:DT` | Rapier's own impact response, time step DT (s) |
+//!
+//! Every finished run's report is written to `--out DIR` as JSON; a later call
+//! with the same DIR and the same row reuses the saved reports instead of
+//! running them again (so a long table can be built in several sittings).
+//! The error of v̂_na is taken against the `--baseline` run (by default the
+//! reference run with the smallest tolerance, else the first reference run).
+
+use std::path::PathBuf;
+use std::time::Instant;
+
+use anyhow::{bail, Context};
+
+use super::chain::{row_spec, RowArgs};
+use topple::domino::{ChainReport, RowSpec};
+use topple::rapier::scene::{Engine, SolverSpec};
+use topple::reference::{Integrator, Settings};
+
+/// Arguments of `topple bench`.
+#[derive(clap::Args, Debug)]
+pub struct Args {
+    /// The row.
+    #[command(flatten)]
+    pub row: RowArgs,
+    /// Runs (see the module table), comma-separated, e.g.
+    /// `reference:paper,reference:1e-8,rapier:1e-3:1e-4,native:1e-3`.
+    #[arg(long, value_delimiter = ',', required = true)]
+    pub runs: Vec<String>,
+    /// The run the v̂_na errors are measured against (one of --runs).
+    #[arg(long)]
+    pub baseline: Option<String>,
+    /// Directory for the run reports (JSON); saved reports of the same row are
+    /// reused.
+    #[arg(long)]
+    pub out: Option<PathBuf>,
+    /// Rapier engines: impact window (closed contacts from the struck pair).
+    #[arg(long, default_value_t = 8)]
+    pub window: usize,
+    /// Rapier engines: stop after this much simulated time (s).
+    #[arg(long, default_value_t = 600.0)]
+    pub max_time: f64,
+}
+
+/// One parsed run.
+#[derive(Clone, Debug, PartialEq)]
+enum RunKind {
+    Reference(Integrator),
+    Rapier {
+        dt: f64,
+        impulse_step: f64,
+        tolerance: Option<f64>,
+    },
+    Native {
+        dt: f64,
+    },
+}
+
+fn number(text: &str, what: &str, run: &str) -> anyhow::Result<f64> {
+    let v: f64 = text
+        .parse()
+        .with_context(|| format!("run {run:?}: {what} {text:?} is not a number"))?;
+    if !(v.is_finite() && v > 0.0) {
+        bail!("run {run:?}: {what} must be positive and finite, got {text}");
+    }
+    Ok(v)
+}
+
+fn parse_run(run: &str) -> anyhow::Result<RunKind> {
+    let parts: Vec<&str> = run.split(':').collect();
+    Ok(match parts.as_slice() {
+        ["reference", "paper"] => RunKind::Reference(Integrator::Paper { dt: 1e-4 }),
+        ["reference", "paper", dt] => RunKind::Reference(Integrator::Paper {
+            dt: number(dt, "time step", run)?,
+        }),
+        ["reference", tol] => RunKind::Reference(Integrator::Adaptive {
+            tolerance: number(tol, "tolerance", run)?,
+        }),
+        ["rapier", dt, "tol", tol] => RunKind::Rapier {
+            dt: number(dt, "time step", run)?,
+            impulse_step: 1e-4,
+            tolerance: Some(number(tol, "tolerance", run)?),
+        },
+        ["rapier", dt, step] => RunKind::Rapier {
+            dt: number(dt, "time step", run)?,
+            impulse_step: number(step, "impulse step", run)?,
+            tolerance: None,
+        },
+        ["native", dt] => RunKind::Native {
+            dt: number(dt, "time step", run)?,
+        },
+        _ => bail!(
+            "run {run:?} is not one of reference:paper[:DT], reference:TOL, \
+             rapier:DT:STEP, rapier:DT:tol:TOL, native:DT"
+        ),
+    })
+}
+
+/// A saved run: the row it belongs to and the engine's report.
+#[derive(serde::Serialize, serde::Deserialize)]
+struct Saved {
+    run: String,
+    row: RowSpec,
+    report: ChainReport,
+}
+
+fn execute(kind: &RunKind, row: &RowSpec, args: &Args) -> anyhow::Result<ChainReport> {
+    Ok(match *kind {
+        RunKind::Reference(integrator) => {
+            let settings = Settings {
+                integrator,
+                ..Default::default()
+            };
+            topple::reference::run(row, &settings)?.report
+        }
+        RunKind::Rapier {
+            dt,
+            impulse_step,
+            tolerance,
+        } => topple::rapier::chain::run_row(
+            row,
+            Engine::Rapier,
+            SolverSpec {
+                dt,
+                impulse_step,
+                tolerance,
+                max_group_hops: Some(args.window),
+                ..Default::default()
+            },
+            args.max_time,
+        )?,
+        RunKind::Native { dt } => topple::rapier::chain::run_row(
+            row,
+            Engine::RapierNative,
+            SolverSpec {
+                dt,
+                max_group_hops: Some(args.window),
+                ..Default::default()
+            },
+            args.max_time,
+        )?,
+    })
+}
+
+fn file_name(run: &str) -> String {
+    let safe: String = run
+        .chars()
+        .map(|c| {
+            if c.is_ascii_alphanumeric() || c == '.' || c == '-' {
+                c
+            } else {
+                '_'
+            }
+        })
+        .collect();
+    format!("{safe}.json")
+}
+
+/// The default baseline: the reference run with the smallest tolerance, else
+/// the reference run with the smallest time step.
+fn default_baseline(kinds: &[(String, RunKind)]) -> Option<usize> {
+    let key = |k: &RunKind| match *k {
+        RunKind::Reference(Integrator::Adaptive { tolerance }) => Some((0, tolerance)),
+        RunKind::Reference(Integrator::Paper { dt }) => Some((1, dt)),
+        _ => None,
+    };
+    (0..kinds.len())
+        .filter_map(|i| key(&kinds[i].1).map(|k| (k, i)))
+        .min_by(|a, b| a.0.partial_cmp(&b.0).unwrap_or(std::cmp::Ordering::Equal))
+        .map(|(_, i)| i)
+}
+
+pub fn run(args: Args) -> anyhow::Result<()> {
+    let row = row_spec(&args.row)?;
+    row.validate()
+        .map_err(|e| anyhow::anyhow!("invalid row: {e}"))?;
+    let kinds: Vec<(String, RunKind)> = args
+        .runs
+        .iter()
+        .map(|r| parse_run(r.trim()).map(|k| (r.trim().to_string(), k)))
+        .collect::<anyhow::Result<_>>()?;
+    let baseline = match &args.baseline {
+        Some(b) => Some(
+            kinds
+                .iter()
+                .position(|(name, _)| name == b.trim())
+                .with_context(|| format!("--baseline {b:?} is not one of --runs"))?,
+        ),
+        None => default_baseline(&kinds),
+    };
+    if let Some(dir) = &args.out {
+        std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
+    }
+    let mut reports: Vec<ChainReport> = Vec::with_capacity(kinds.len());
+    for (k, (name, kind)) in kinds.iter().enumerate() {
+        let path = args.out.as_ref().map(|d| d.join(file_name(name)));
+        let saved = path
+            .as_ref()
+            .filter(|p| p.exists())
+            .map(|p| -> anyhow::Result<Saved> {
+                let text = std::fs::read_to_string(p)
+                    .with_context(|| format!("reading {}", p.display()))?;
+                serde_json::from_str(&text).with_context(|| format!("parsing {}", p.display()))
+            })
+            .transpose()?
+            .filter(|s| s.row == row && s.run == *name);
+        let report = match saved {
+            Some(s) => {
+                eprintln!("[{}/{}] {name}: saved report reused", k + 1, kinds.len());
+                s.report
+            }
+            None => {
+                eprintln!("[{}/{}] {name}: running…", k + 1, kinds.len());
+                let start = Instant::now();
+                let report = execute(kind, &row, &args).with_context(|| format!("run {name}"))?;
+                eprintln!(
+                    "[{}/{}] {name}: {:.1} s, v̂_na {}",
+                    k + 1,
+                    kinds.len(),
+                    start.elapsed().as_secs_f64(),
+                    report
+                        .natural_speed
+                        .map_or("none".to_string(), |v| format!("{v:.5}"))
+                );
+                if let Some(p) = &path {
+                    let saved = Saved {
+                        run: name.clone(),
+                        row,
+                        report: report.clone(),
+                    };
+                    std::fs::write(p, serde_json::to_string_pretty(&saved)?)
+                        .with_context(|| format!("writing {}", p.display()))?;
+                }
+                report
+            }
+        };
+        reports.push(report);
+    }
+    print_table(&args, &row, &kinds, &reports, baseline);
+    Ok(())
+}
+
+/// Rapier time step of a run, if it is a Rapier run.
+fn rapier_dt(kind: &RunKind) -> Option<f64> {
+    match *kind {
+        RunKind::Rapier { dt, .. } | RunKind::Native { dt } => Some(dt),
+        RunKind::Reference(_) => None,
+    }
+}
+
+fn print_table(
+    args: &Args,
+    row: &RowSpec,
+    kinds: &[(String, RunKind)],
+    reports: &[ChainReport],
+    baseline: Option<usize>,
+) {
+    let base = baseline.and_then(|b| reports[b].natural_speed);
+    println!(
+        "{:?} row, s/h = {}, n = {}, push = {}; error of v̂_na against {}",
+        args.row.preset,
+        args.row.spacing_ratio,
+        row.n,
+        row.push,
+        baseline.map_or("nothing (no reference run)", |b| kinds[b].0.as_str())
+    );
+    println!();
+    println!("| run | run time (s) | blocks hit | impacts | held / plastic | ms/step | topple/native | v̂_na | spread (std) | error |");
+    println!("| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |");
+    // held / plastic: impacts solved again with e = 0 contacts held, and
+    // impacts resolved as plastic (reference engine only)
+    for (k, ((name, kind), r)) in kinds.iter().zip(reports).enumerate() {
+        // Rapier: wall time per Rapier step; the ratio against the native run
+        // at the same step from this same invocation.
+        let ms_per_step = rapier_dt(kind).map(|dt| {
+            let steps = (r.simulated_time / dt).round().max(1.0);
+            1e3 * r.run_time / steps
+        });
+        let native_ms = rapier_dt(kind).and_then(|dt| {
+            kinds
+                .iter()
+                .zip(reports)
+                .find(|((_, k2), _)| *k2 == RunKind::Native { dt })
+                .map(|(_, r2)| 1e3 * r2.run_time / (r2.simulated_time / dt).round().max(1.0))
+        });
+        let ratio = match (kind, ms_per_step, native_ms) {
+            (RunKind::Rapier { .. }, Some(a), Some(b)) => format!("{:.2}", a / b),
+            (RunKind::Native { .. }, _, _) => "1".into(),
+            _ => "-".into(),
+        };
+        let error = match (r.natural_speed, base) {
+            (_, _) if Some(k) == baseline => "baseline".to_string(),
+            (Some(v), Some(b)) => format!("{:.2e}", ((v - b) / b).abs()),
+            _ => "-".into(),
+        };
+        println!(
+            "| {name} | {:.1} | {}/{} | {} | {} / {} | {} | {ratio} | {} | {} | {error} |",
+            r.run_time,
+            r.hit_times.len(),
+            row.n,
+            r.impacts,
+            r.held_impacts,
+            r.impact_fallbacks,
+            ms_per_step.map_or("-".to_string(), |m| format!("{m:.3}")),
+            r.natural_speed
+                .map_or("none".to_string(), |v| format!("{v:.5}")),
+            r.natural_speed_spread
+                .map_or("-".to_string(), |s| format!("{:.4}", s.std_dev)),
+        );
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn runs_parse_and_bad_ones_are_refused() {
+        assert_eq!(
+            parse_run("reference:paper").unwrap(),
+            RunKind::Reference(Integrator::Paper { dt: 1e-4 })
+        );
+        assert_eq!(
+            parse_run("reference:1e-8").unwrap(),
+            RunKind::Reference(Integrator::Adaptive { tolerance: 1e-8 })
+        );
+        assert_eq!(
+            parse_run("rapier:1e-3:1e-4").unwrap(),
+            RunKind::Rapier {
+                dt: 1e-3,
+                impulse_step: 1e-4,
+                tolerance: None
+            }
+        );
+        assert_eq!(
+            parse_run("native:5e-4").unwrap(),
+            RunKind::Native { dt: 5e-4 }
+        );
+        for bad in ["rapier:1e-3", "native:-1", "reference:abc", "bullet:1e-3"] {
+            assert!(parse_run(bad).is_err(), "{bad}");
+        }
+    }
+
+    #[test]
+    fn the_default_baseline_is_the_tightest_reference_run() {
+        let kinds: Vec<(String, RunKind)> = [
+            "native:1e-3",
+            "reference:paper",
+            "reference:1e-6",
+            "reference:1e-9",
+        ]
+        .iter()
+        .map(|r| (r.to_string(), parse_run(r).unwrap()))
+        .collect();
+        assert_eq!(default_baseline(&kinds), Some(3));
+        assert_eq!(default_baseline(&kinds[..2]), Some(1));
+        assert_eq!(default_baseline(&kinds[..1]), None);
+    }
+}
