@@ -270,8 +270,8 @@ pub fn run_cmd(args: Args) -> anyhow::Result<()> {
     for (j, r) in jobs.iter().zip(results.iter()) {
         match r {
             Err(e) => eprintln!("warning: {e}"),
-            Ok(r) if r.stopped_early || r.impact_fallbacks > 0 => eprintln!(
-                "warning: fig {} {} x={}: {}{} plastic fallbacks, {} of {} blocks reached",
+            Ok(r) if r.stopped_early || r.impact_fallbacks > 0 || r.held_impacts > 0 => eprintln!(
+                "warning: fig {} {} x={}: {}{} plastic fallbacks, {} held impacts, {} of {} blocks reached",
                 j.fig,
                 j.key,
                 j.x,
@@ -281,6 +281,7 @@ pub fn run_cmd(args: Args) -> anyhow::Result<()> {
                     ""
                 },
                 r.impact_fallbacks,
+                r.held_impacts,
                 r.hit_times.len(),
                 j.row.n
             ),
