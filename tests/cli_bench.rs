@@ -62,19 +62,25 @@ fn table_errors_are_against_the_baseline_and_saved_runs_are_reused() {
         saved_speed(&dir, "reference_paper.json"),
         saved_speed(&dir, "reference_paper_5e-5.json"),
     );
-    let printed: f64 = row("reference:paper")[10].parse().unwrap();
+    let printed: f64 = row("reference:paper")[12].parse().unwrap();
     let expected = ((v - base) / base).abs();
     assert!(
         (printed - expected).abs() <= 0.01 * expected + 1e-12,
         "{printed} vs {expected}"
     );
-    assert_eq!(row("reference:paper:5e-5")[10], "baseline");
+    assert_eq!(row("reference:paper:5e-5")[12], "baseline");
     // native Rapier: time per step and its ratio column
-    assert_eq!(row("native:1e-3")[7], "1");
+    assert_eq!(row("native:1e-3")[9], "1");
     // every block hit in every run
     for name in ["reference:paper", "reference:paper:5e-5", "native:1e-3"] {
         assert_eq!(row(name)[3], "12/12", "{name}");
     }
+    // the reference engine hits the blocks in order
+    assert_eq!(row("reference:paper")[4], "0");
+    // the front speed is distance over time, the harmonic mean of the v̂_i
+    // over the same blocks, so it cannot exceed their arithmetic mean v̂_na
+    let front: f64 = row("reference:paper")[5].parse().unwrap();
+    assert!(front > 0.0 && front <= v * (1.0 + 1e-9), "{front} vs {v}");
     let stderr = String::from_utf8_lossy(&first.stderr);
     assert!(
         stderr.contains("[1/3] reference:paper: running"),

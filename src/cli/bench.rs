@@ -17,7 +17,12 @@
 //! with the same DIR and the same row reuses the saved reports instead of
 //! running them again (so a long table can be built in several sittings).
 //! The error of v̂_na is taken against the `--baseline` run (by default the
-//! reference run with the smallest tolerance, else the first reference run).
+//! reference run with the smallest tolerance, else the reference run with the
+//! smallest time step). Columns besides run time and v̂_na: blocks hit; "out
+//! of order", intervals t_i ≤ 0 (then v̂_na is infinite and shown as none);
+//! "front v̂", the front's distance over time from block 7 to the last block
+//! hit over √(gh), robust to such bunches, with its own error; Rapier's wall
+//! time per step and its ratio to the native run at the same step.
 
 use std::path::PathBuf;
 use std::time::Instant;
@@ -252,6 +257,19 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     Ok(())
 }
 
+/// The front's mean speed from block 7 to the last block hit, over √(gh):
+/// distance over time, so a few blocks hit together do not make it infinite
+/// (unlike the mean of the v̂_i, v̂_na). `None` when fewer than 8 blocks hit.
+fn front_speed(r: &ChainReport, row: &RowSpec) -> Option<f64> {
+    let first = topple::domino::FIRST_STEADY_BLOCK - 1; // 0-based
+    let last = r.hit_times.len().checked_sub(1)?;
+    if last <= first {
+        return None;
+    }
+    let time = r.hit_times[last] - r.hit_times[first];
+    (time > 0.0).then(|| (last - first) as f64 * row.pitch() / time / row.params.speed_scale())
+}
+
 /// Rapier time step of a run, if it is a Rapier run.
 fn rapier_dt(kind: &RunKind) -> Option<f64> {
     match *kind {
@@ -267,7 +285,10 @@ fn print_table(
     reports: &[ChainReport],
     baseline: Option<usize>,
 ) {
-    let base = baseline.and_then(|b| reports[b].natural_speed);
+    let base = baseline
+        .and_then(|b| reports[b].natural_speed)
+        .filter(|v| v.is_finite());
+    let base_front = baseline.and_then(|b| front_speed(&reports[b], row));
     println!(
         "{:?} row, s/h = {}, n = {}, push = {}; error of v̂_na against {}",
         args.row.preset,
@@ -277,8 +298,11 @@ fn print_table(
         baseline.map_or("nothing (no reference run)", |b| kinds[b].0.as_str())
     );
     println!();
-    println!("| run | run time (s) | blocks hit | impacts | held / plastic | ms/step | topple/native | v̂_na | spread (std) | error |");
-    println!("| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |");
+    println!("| run | run time (s) | blocks hit | out of order | front v̂ | impacts | held / plastic | ms/step | topple/native | v̂_na | spread (std) | error | front error |");
+    println!("| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |");
+    // out of order: intervals t_i ≤ 0 (a block first hit no later than the
+    // one before it), where v̂_i means nothing; v̂_na is then infinite or
+    // meaningless and shown as "none".
     // held / plastic: impacts solved again with e = 0 contacts held, and
     // impacts resolved as plastic (reference engine only)
     for (k, ((name, kind), r)) in kinds.iter().zip(reports).enumerate() {
@@ -300,23 +324,29 @@ fn print_table(
             (RunKind::Native { .. }, _, _) => "1".into(),
             _ => "-".into(),
         };
-        let error = match (r.natural_speed, base) {
-            (_, _) if Some(k) == baseline => "baseline".to_string(),
+        let relative = |v: Option<f64>, b: Option<f64>| match (v, b) {
+            _ if Some(k) == baseline => "baseline".to_string(),
             (Some(v), Some(b)) => format!("{:.2e}", ((v - b) / b).abs()),
             _ => "-".into(),
         };
+        let error = relative(r.natural_speed.filter(|v| v.is_finite()), base);
+        let front_error = relative(front_speed(r, row), base_front);
         println!(
-            "| {name} | {:.1} | {}/{} | {} | {} / {} | {} | {ratio} | {} | {} | {error} |",
+            "| {name} | {:.1} | {}/{} | {} | {} | {} | {} / {} | {} | {ratio} | {} | {} | {error} | {front_error} |",
             r.run_time,
             r.hit_times.len(),
             row.n,
+            r.intervals.iter().filter(|t| t.is_nan() || **t <= 0.0).count(),
+            front_speed(r, row).map_or("-".to_string(), |v| format!("{v:.5}")),
             r.impacts,
             r.held_impacts,
             r.impact_fallbacks,
             ms_per_step.map_or("-".to_string(), |m| format!("{m:.3}")),
             r.natural_speed
+                .filter(|v| v.is_finite())
                 .map_or("none".to_string(), |v| format!("{v:.5}")),
             r.natural_speed_spread
+                .filter(|s| s.std_dev.is_finite())
                 .map_or("-".to_string(), |s| format!("{:.4}", s.std_dev)),
         );
     }

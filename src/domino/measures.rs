@@ -8,16 +8,38 @@ use super::RowSpec;
 /// paper lets the wave pass "the first 6 blocks" (Sec. 3.1).
 pub const FIRST_STEADY_BLOCK: usize = 7;
 
+/// JSON has no infinity or NaN: serde_json writes them as `null`. These read
+/// `null` back as NaN, so that a saved report with a non-finite value (two
+/// blocks hit in the same Rapier step give t_i = 0 and v̂_i = ∞) still loads.
+pub(crate) mod nullable {
+    use serde::{Deserialize, Deserializer};
+
+    /// One number, `null` → NaN.
+    pub fn number<'de, D: Deserializer<'de>>(d: D) -> Result<f64, D::Error> {
+        Ok(Option::<f64>::deserialize(d)?.unwrap_or(f64::NAN))
+    }
+
+    /// A list of numbers, each `null` → NaN.
+    pub fn numbers<'de, D: Deserializer<'de>>(d: D) -> Result<Vec<f64>, D::Error> {
+        let v = Vec::<Option<f64>>::deserialize(d)?;
+        Ok(v.into_iter().map(|x| x.unwrap_or(f64::NAN)).collect())
+    }
+}
+
 /// Mean, standard deviation, minimum and maximum of a sample.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Spread {
     /// Arithmetic mean.
+    #[serde(deserialize_with = "nullable::number")]
     pub mean: f64,
     /// Sample standard deviation (0 for one value).
+    #[serde(deserialize_with = "nullable::number")]
     pub std_dev: f64,
     /// Smallest value.
+    #[serde(deserialize_with = "nullable::number")]
     pub min: f64,
     /// Largest value.
+    #[serde(deserialize_with = "nullable::number")]
     pub max: f64,
     /// Number of values.
     pub count: usize,

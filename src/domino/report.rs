@@ -65,9 +65,13 @@ pub struct ChainReport {
     pub natural_speed: Option<f64>,
     /// Spread of the v̂_i averaged in `natural_speed`.
     pub natural_speed_spread: Option<Spread>,
-    /// v̂_i (Eq. 33) for i = 1.. (block i hitting block i+1).
+    /// v̂_i (Eq. 33) for i = 1.. (block i hitting block i+1). Infinite (JSON
+    /// `null`) where two blocks were first hit at the same time, which
+    /// happens in Rapier runs when blocks fall out of order.
+    #[serde(deserialize_with = "super::measures::nullable::numbers")]
     pub speeds: Vec<f64>,
     /// t_i (s).
+    #[serde(deserialize_with = "super::measures::nullable::numbers")]
     pub intervals: Vec<f64>,
     /// Time (s) block i was first hit, i = 1.. (block 1: 0); the blocks never
     /// reached are left out.
