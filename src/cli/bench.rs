@@ -14,7 +14,7 @@
 //! | `native:DT` | Rapier's own impact response, time step DT (s) |
 //!
 //! Every finished run's report is written to `--out DIR` as JSON; a later call
-//! with the same DIR and the same row reuses the saved reports instead of
+//! with the same DIR, row and `--freeze-tolerance` reuses the saved reports instead of
 //! running them again (so a long table can be built in several sittings).
 //! The error of v̂_na is taken against the `--baseline` run (by default the
 //! reference run with the smallest tolerance, else the reference run with the
@@ -54,6 +54,12 @@ pub struct Args {
     /// Rapier engines: impact window (closed contacts from the struck pair).
     #[arg(long, default_value_t = 8)]
     pub window: usize,
+    /// Reference runs: freeze blocks behind the wave below this speed
+    /// (fraction of √(gh)) and acceleration (fraction of g); default 10⁻⁴.
+    /// Rows whose blocks keep bouncing behind the wave (Table 1's e1, e2)
+    /// need 10⁻² for a cost linear in the number of blocks (README).
+    #[arg(long)]
+    pub freeze_tolerance: Option<f64>,
     /// Rapier engines: stop after this much simulated time (s).
     #[arg(long, default_value_t = 600.0)]
     pub max_time: f64,
@@ -118,16 +124,22 @@ fn parse_run(run: &str) -> anyhow::Result<RunKind> {
 struct Saved {
     run: String,
     row: RowSpec,
+    /// `--freeze-tolerance` of the run (reference runs), if given.
+    #[serde(default)]
+    freeze_tolerance: Option<f64>,
     report: ChainReport,
 }
 
 fn execute(kind: &RunKind, row: &RowSpec, args: &Args) -> anyhow::Result<ChainReport> {
     Ok(match *kind {
         RunKind::Reference(integrator) => {
-            let settings = Settings {
+            let mut settings = Settings {
                 integrator,
                 ..Default::default()
             };
+            if let Some(f) = args.freeze_tolerance {
+                settings.freeze_tolerance = f;
+            }
             topple::reference::run(row, &settings)?.report
         }
         RunKind::Rapier {
@@ -211,6 +223,11 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     let mut reports: Vec<ChainReport> = Vec::with_capacity(kinds.len());
     for (k, (name, kind)) in kinds.iter().enumerate() {
         let path = args.out.as_ref().map(|d| d.join(file_name(name)));
+        // the freeze tolerance matters to reference runs only
+        let freeze = match kind {
+            RunKind::Reference(_) => args.freeze_tolerance,
+            _ => None,
+        };
         let saved = path
             .as_ref()
             .filter(|p| p.exists())
@@ -220,7 +237,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
                 serde_json::from_str(&text).with_context(|| format!("parsing {}", p.display()))
             })
             .transpose()?
-            .filter(|s| s.row == row && s.run == *name);
+            .filter(|s| s.row == row && s.run == *name && s.freeze_tolerance == freeze);
         let report = match saved {
             Some(s) => {
                 eprintln!("[{}/{}] {name}: saved report reused", k + 1, kinds.len());
@@ -243,6 +260,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
                     let saved = Saved {
                         run: name.clone(),
                         row,
+                        freeze_tolerance: freeze,
                         report: report.clone(),
                     };
                     std::fs::write(p, serde_json::to_string_pretty(&saved)?)
