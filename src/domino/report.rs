@@ -128,3 +128,28 @@ impl ChainReport {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::domino::Preset;
+
+    /// Saved reports are matched to rows by equality (`topple bench`), so a
+    /// report must come back from JSON bit for bit, infinite speeds as NaN.
+    #[test]
+    fn a_report_round_trips_through_json() {
+        let p = Preset::X.params();
+        let row = RowSpec::new(p, 0.18 * p.block.height, 12, 1.0);
+        // blocks 3 and 4 hit at the same time: t_3 = 0, v̂_3 infinite
+        let hits = vec![0.0, 0.1, 0.2, 0.2, 0.30000000000000004, 0.4];
+        let report = ChainReport::new("rapier", &row, hits);
+        assert!(report.speeds.iter().any(|v| v.is_infinite()));
+        let text = serde_json::to_string(&report).unwrap();
+        let back: ChainReport = serde_json::from_str(&text).unwrap();
+        assert_eq!(back.row, row);
+        assert_eq!(back.hit_times, report.hit_times);
+        for (a, b) in back.speeds.iter().zip(&report.speeds) {
+            assert!(a == b || (a.is_nan() && b.is_infinite()), "{a} vs {b}");
+        }
+    }
+}
