@@ -57,3 +57,31 @@ fn a_bad_time_step_is_an_error() {
     assert!(!out.status.success());
     assert!(out.stdout.is_empty());
 }
+
+/// The issue writes `--preset X|T|P`: upper and lower case name the same row,
+/// and an unknown preset is a one-line error with nothing on stdout.
+#[test]
+fn preset_names_ignore_case() {
+    let run = |preset: &str| {
+        Command::new(env!("CARGO_BIN_EXE_topple"))
+            .args(["chain", "--preset", preset, "--spacing-ratio", "0.35"])
+            .args(["--n", "8", "--engine", "rapier", "--dt", "1e-3", "--json"])
+            .output()
+            .unwrap()
+    };
+    let (upper, lower) = (run("T"), run("t"));
+    assert!(
+        upper.status.success(),
+        "{}",
+        String::from_utf8_lossy(&upper.stderr)
+    );
+    let report = |o: &std::process::Output| {
+        let mut v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+        v.as_object_mut().unwrap().remove("run_time"); // wall clock
+        v
+    };
+    assert_eq!(report(&upper), report(&lower));
+    let bad = run("Q");
+    assert!(!bad.status.success());
+    assert!(bad.stdout.is_empty());
+}

@@ -45,8 +45,8 @@ pub enum EngineArg {
 /// `topple chain` and `topple bench`).
 #[derive(clap::Args, Debug, Clone)]
 pub struct RowArgs {
-    /// Block type (Table 1).
-    #[arg(long, value_enum, default_value = "x")]
+    /// Block type (Table 1); case-insensitive (X, T, P as in the paper).
+    #[arg(long, value_enum, ignore_case = true, default_value = "x")]
     pub preset: PresetArg,
     /// Gap over height, s/h.
     #[arg(long)]
