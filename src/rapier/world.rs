@@ -231,11 +231,86 @@ impl ToppleRapier {
         Some(self.slot[i] as usize)
     }
 
+    /// Queries one candidate pair of managed convex colliders at the current
+    /// positions; its closed points become [`PointContact`]s (λ points on a
+    /// flat patch) and the pair is recorded as closed.
+    fn query_pair(
+        &mut self,
+        collider1: ColliderHandle,
+        collider2: ColliderHandle,
+        bodies: &RigidBodySet,
+        colliders: &ColliderSet,
+    ) {
+        let Some(material) = self.hooks.pair(collider1, collider2).map(|m| m.impact) else {
+            return;
+        };
+        let (Some(co1), Some(co2)) = (colliders.get(collider1), colliders.get(collider2)) else {
+            return;
+        };
+        if !(co1.shape().is_convex() && co2.shape().is_convex()) {
+            return;
+        }
+        let rule = self.settings.patch;
+        self.stats.pairs_queried += 1;
+        let (pos1, pos2) = (co1.position(), co2.position());
+        let pos12 = pos1.inv_mul(pos2);
+        self.manifold.clear();
+        if DefaultQueryDispatcher
+            .contact_manifold_convex_convex(
+                &pos12,
+                co1.shape(),
+                co2.shape(),
+                None,
+                None,
+                rule.closed_tolerance.max(0.0),
+                &mut self.manifold,
+            )
+            .is_err()
+            || self.manifold.points.is_empty()
+        {
+            return;
+        }
+        let normal = v2(pos1.transform_vector(self.manifold.local_n1).normalize());
+        self.points.clear();
+        for p in &self.manifold.points {
+            let a = pos1.transform_point(p.local_p1);
+            let b = pos2.transform_point(p.local_p2);
+            self.points.push(ManifoldPoint {
+                point: [0.5 * (a.x + b.x), 0.5 * (a.y + b.y)],
+                dist: p.dist,
+            });
+        }
+        if !self.points.iter().any(|p| p.dist <= rule.closed_tolerance) {
+            return;
+        }
+        let b1 = self.slot_of(bodies, co1.parent());
+        let b2 = self.slot_of(bodies, co2.parent());
+        if b1.is_none() && b2.is_none() {
+            return;
+        }
+        let key = pair_key(collider1, collider2);
+        let persistent = self.hooks.was_closed(key);
+        self.closed_now.push(key);
+        let contacts = &mut self.contacts;
+        for_each_contact_point(&self.points, &rule, |point, dist| {
+            contacts.push(PointContact {
+                bodies: [b1, b2],
+                point,
+                normal,
+                dist,
+                material,
+                persistent,
+            })
+        });
+    }
+
     /// Resolves the impacts at the current positions of a Rapier world and
     /// writes the post-impact velocities back (waking the bodies). Only pairs
-    /// in Rapier's contact graph with at least one awake dynamic body and both
-    /// colliders managed are queried; pairs of non-convex shapes are skipped.
-    /// Returns the number of impacts resolved.
+    /// in Rapier's contact graph with both colliders managed are queried: those
+    /// with at least one awake dynamic body, and the pairs of a sleeping body
+    /// that such a pair touches (so a struck sleeping body keeps its
+    /// supports); pairs of non-convex shapes are skipped. Returns the number
+    /// of impacts resolved.
     pub fn resolve_impacts(
         &mut self,
         bodies: &mut RigidBodySet,
@@ -250,82 +325,53 @@ impl ToppleRapier {
         self.handles.clear();
         self.contacts.clear();
         self.closed_now.clear();
-        let rule = self.settings.patch;
-        let prediction = rule.closed_tolerance.max(0.0);
-        let dispatcher = DefaultQueryDispatcher;
+        let awake = |h: Option<RigidBodyHandle>| {
+            h.and_then(|h| bodies.get(h))
+                .is_some_and(|rb| rb.is_dynamic() && !rb.is_sleeping())
+        };
         for pair in narrow_phase.contact_pairs() {
-            let Some(material) = self.hooks.pair(pair.collider1, pair.collider2) else {
-                continue;
-            };
-            let material = material.impact;
             let (Some(co1), Some(co2)) =
                 (colliders.get(pair.collider1), colliders.get(pair.collider2))
             else {
                 continue;
             };
-            let awake = |h: Option<RigidBodyHandle>| {
-                h.and_then(|h| bodies.get(h))
-                    .is_some_and(|rb| rb.is_dynamic() && !rb.is_sleeping())
-            };
-            if !awake(co1.parent()) && !awake(co2.parent()) {
+            if awake(co1.parent()) || awake(co2.parent()) {
+                self.query_pair(pair.collider1, pair.collider2, bodies, colliders);
+            }
+        }
+        // A sleeping body touched by an awake one brings its own closed
+        // contacts (its support, the stack it sits in): an impact on it must
+        // see them. Rapier did not move it, so its other pairs were skipped
+        // above. Breadth first over the bodies that got a slot; a pair of two
+        // such bodies is queried once, by the one expanded first.
+        let mut next = 0;
+        while next < self.handles.len() {
+            let h = self.handles[next];
+            next += 1;
+            let Some(rb) = bodies.get(h) else { continue };
+            if !rb.is_sleeping() {
                 continue;
             }
-            if !(co1.shape().is_convex() && co2.shape().is_convex()) {
-                continue;
+            for &collider in rb.colliders() {
+                for pair in narrow_phase.contact_pairs_with(collider) {
+                    let other = if pair.collider1 == collider {
+                        pair.collider2
+                    } else {
+                        pair.collider1
+                    };
+                    let other_body = colliders.get(other).and_then(|co| co.parent());
+                    if awake(other_body) {
+                        continue; // queried in the first pass
+                    }
+                    let expanded = other_body
+                        .map(|b| b.into_raw_parts().0 as usize)
+                        .and_then(|i| self.slot.get(i))
+                        .is_some_and(|&s| s != NO_SLOT && (s as usize) < next - 1);
+                    if !expanded {
+                        self.query_pair(pair.collider1, pair.collider2, bodies, colliders);
+                    }
+                }
             }
-            self.stats.pairs_queried += 1;
-            let (pos1, pos2) = (co1.position(), co2.position());
-            let pos12 = pos1.inv_mul(pos2);
-            self.manifold.clear();
-            if dispatcher
-                .contact_manifold_convex_convex(
-                    &pos12,
-                    co1.shape(),
-                    co2.shape(),
-                    None,
-                    None,
-                    prediction,
-                    &mut self.manifold,
-                )
-                .is_err()
-            {
-                continue;
-            }
-            if self.manifold.points.is_empty() {
-                continue;
-            }
-            let normal = v2(pos1.transform_vector(self.manifold.local_n1).normalize());
-            self.points.clear();
-            for p in &self.manifold.points {
-                let a = pos1.transform_point(p.local_p1);
-                let b = pos2.transform_point(p.local_p2);
-                self.points.push(ManifoldPoint {
-                    point: [0.5 * (a.x + b.x), 0.5 * (a.y + b.y)],
-                    dist: p.dist,
-                });
-            }
-            if !self.points.iter().any(|p| p.dist <= rule.closed_tolerance) {
-                continue;
-            }
-            let b1 = self.slot_of(bodies, co1.parent());
-            let b2 = self.slot_of(bodies, co2.parent());
-            if b1.is_none() && b2.is_none() {
-                continue;
-            }
-            let key = pair_key(pair.collider1, pair.collider2);
-            let persistent = self.hooks.was_closed(key);
-            self.closed_now.push(key);
-            let contacts = &mut self.contacts;
-            for_each_contact_point(&self.points, &rule, |point, dist| {
-                contacts.push(PointContact {
-                    bodies: [b1, b2],
-                    point,
-                    normal,
-                    dist,
-                    material,
-                    persistent,
-                })
-            });
         }
         self.stats.contact_points += self.contacts.len() as u64;
         let result = self.groups.resolve(
