@@ -21,8 +21,10 @@ const DT: f64 = 1e-3; // s
 /// Ball, top box, bottom box: (linear velocity, angular velocity) after the
 /// step in which the ball strikes.
 fn strike(asleep: bool, ground: bool) -> Vec<([f64; 2], f64)> {
-    let mut world = PhysicsWorld::default();
-    world.gravity = Vector::ZERO;
+    let mut world = PhysicsWorld {
+        gravity: Vector::ZERO,
+        ..PhysicsWorld::default()
+    };
     world.integration_parameters.dt = DT;
     let mut topple = ToppleRapier::new(ToppleSettings::default());
     let material = topple.add_material(PairMaterial::from_table(
