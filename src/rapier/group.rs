@@ -178,6 +178,22 @@ pub fn normal_velocity(bodies: &[Body], c: &PointContact) -> f64 {
     c.normal[0] * (v2[0] - v1[0]) + c.normal[1] * (v2[1] - v1[1])
 }
 
+/// The approach speed −δ̇ of a contact that starts an impact: closed, new
+/// (not persistent), approaching faster than `min_approach_speed`, with a
+/// free body on at least one side. `None` for every other contact.
+pub(crate) fn seed_approach(
+    bodies: &[Body],
+    c: &PointContact,
+    settings: &ToppleSettings,
+) -> Option<f64> {
+    if c.dist > settings.patch.closed_tolerance || c.persistent {
+        return None;
+    }
+    let free = |i: Option<usize>| i.is_some_and(|i| !bodies[i].fixed);
+    let vn = normal_velocity(bodies, c);
+    (vn < -settings.min_approach_speed && (free(c.bodies[0]) || free(c.bodies[1]))).then_some(-vn)
+}
+
 fn find(parent: &mut [usize], mut i: usize) -> usize {
     while parent[i] != i {
         parent[i] = parent[parent[i]];
@@ -212,13 +228,8 @@ impl ImpactGroups {
         // when there are none (the common case).
         self.seeds.clear();
         for (k, c) in contacts.iter().enumerate() {
-            if c.dist <= tol && !c.persistent {
-                let vn = normal_velocity(bodies, c);
-                if vn < -settings.min_approach_speed
-                    && (free(c.bodies[0], bodies).is_some() || free(c.bodies[1], bodies).is_some())
-                {
-                    self.seeds.push((k, -vn));
-                }
+            if let Some(approach) = seed_approach(bodies, c, settings) {
+                self.seeds.push((k, approach));
             }
         }
         if self.seeds.is_empty() {

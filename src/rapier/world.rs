@@ -12,7 +12,7 @@ use rapier2d_f64::prelude::{
 
 use crate::impact::{Body, ImpactError};
 
-use super::group::{ImpactGroups, ImpactReport, PointContact, ToppleSettings};
+use super::group::{seed_approach, ImpactGroups, ImpactReport, PointContact, ToppleSettings};
 use super::hooks::{HookMode, ToppleHooks};
 use super::material::{MaterialId, PairMaterial};
 use super::patch::{for_each_contact_point, ManifoldPoint};
@@ -231,6 +231,49 @@ impl ToppleRapier {
         Some(self.slot[i] as usize)
     }
 
+    /// Queries the pairs of the `k`-th body (if it sleeps) with bodies that
+    /// are not awake (fixed, or sleeping and not expanded yet).
+    fn expand_sleeping(
+        &mut self,
+        k: usize,
+        bodies: &RigidBodySet,
+        colliders: &ColliderSet,
+        narrow_phase: &NarrowPhase,
+    ) {
+        let Some(rb) = bodies.get(self.handles[k]) else {
+            return;
+        };
+        if !rb.is_sleeping() {
+            return;
+        }
+        for &collider in rb.colliders() {
+            for pair in narrow_phase.contact_pairs_with(collider) {
+                let other = if pair.collider1 == collider {
+                    pair.collider2
+                } else {
+                    pair.collider1
+                };
+                let other_body = colliders
+                    .get(other)
+                    .and_then(|co| co.parent())
+                    .and_then(|h| bodies.get(h).map(|rb| (h, rb)));
+                let skip = other_body.is_some_and(|(h, rb)| {
+                    let slot = self
+                        .slot
+                        .get(h.into_raw_parts().0 as usize)
+                        .copied()
+                        .unwrap_or(NO_SLOT);
+                    // awake: queried in the first pass; expanded: queried then
+                    (rb.is_dynamic() && !rb.is_sleeping())
+                        || (slot != NO_SLOT && (slot as usize) < k)
+                });
+                if !skip {
+                    self.query_pair(pair.collider1, pair.collider2, bodies, colliders);
+                }
+            }
+        }
+    }
+
     /// Queries one candidate pair of managed convex colliders at the current
     /// positions; its closed points become [`PointContact`]s (λ points on a
     /// flat patch) and the pair is recorded as closed.
@@ -339,37 +382,34 @@ impl ToppleRapier {
                 self.query_pair(pair.collider1, pair.collider2, bodies, colliders);
             }
         }
-        // A sleeping body touched by an awake one brings its own closed
-        // contacts (its support, the stack it sits in): an impact on it must
-        // see them. Rapier did not move it, so its other pairs were skipped
-        // above. Breadth first over the bodies that got a slot; a pair of two
-        // such bodies is queried once, by the one expanded first.
-        let mut next = 0;
-        while next < self.handles.len() {
-            let h = self.handles[next];
-            next += 1;
-            let Some(rb) = bodies.get(h) else { continue };
-            if !rb.is_sleeping() {
-                continue;
+        // A sleeping body that an impact reaches brings its own closed
+        // contacts (its support, the stack it sits in), which the pass above
+        // skipped: Rapier has not moved it. Only when there is an impact, and
+        // breadth first by generations: the sleeping bodies found so far,
+        // then those they touch, as far as the impact window reaches; a pair
+        // of two sleeping bodies is queried once, by the one expanded first.
+        // Sleeping bodies found beyond the window stay where they are (fixed).
+        let has_seed = self
+            .contacts
+            .iter()
+            .any(|c| seed_approach(&self.bodies, c, &self.settings).is_some());
+        if has_seed {
+            let generations = self.settings.max_group_hops.map_or(usize::MAX, |h| h + 1);
+            let (mut next, mut generation) = (0, 0);
+            while next < self.handles.len() && generation < generations {
+                let end = self.handles.len();
+                for k in next..end {
+                    self.expand_sleeping(k, bodies, colliders, narrow_phase);
+                }
+                next = end;
+                generation += 1;
             }
-            for &collider in rb.colliders() {
-                for pair in narrow_phase.contact_pairs_with(collider) {
-                    let other = if pair.collider1 == collider {
-                        pair.collider2
-                    } else {
-                        pair.collider1
-                    };
-                    let other_body = colliders.get(other).and_then(|co| co.parent());
-                    if awake(other_body) {
-                        continue; // queried in the first pass
-                    }
-                    let expanded = other_body
-                        .map(|b| b.into_raw_parts().0 as usize)
-                        .and_then(|i| self.slot.get(i))
-                        .is_some_and(|&s| s != NO_SLOT && (s as usize) < next - 1);
-                    if !expanded {
-                        self.query_pair(pair.collider1, pair.collider2, bodies, colliders);
-                    }
+            for k in next..self.handles.len() {
+                if bodies
+                    .get(self.handles[k])
+                    .is_some_and(|rb| rb.is_sleeping())
+                {
+                    self.bodies[k].fixed = true;
                 }
             }
         }
