@@ -131,6 +131,19 @@ struct Saved {
 }
 
 fn execute(kind: &RunKind, row: &RowSpec, args: &Args) -> anyhow::Result<ChainReport> {
+    let bar = super::blocks_bar(row.n, "");
+    let progress = |hit: usize| bar.set_position(hit as u64);
+    let report = execute_with(kind, row, args, progress);
+    bar.finish_and_clear();
+    report
+}
+
+fn execute_with(
+    kind: &RunKind,
+    row: &RowSpec,
+    args: &Args,
+    progress: impl FnMut(usize),
+) -> anyhow::Result<ChainReport> {
     Ok(match *kind {
         RunKind::Reference(integrator) => {
             let mut settings = Settings {
@@ -140,13 +153,13 @@ fn execute(kind: &RunKind, row: &RowSpec, args: &Args) -> anyhow::Result<ChainRe
             if let Some(f) = args.freeze_tolerance {
                 settings.freeze_tolerance = f;
             }
-            topple::reference::run(row, &settings)?.report
+            topple::reference::run_with_progress(row, &settings, progress)?.report
         }
         RunKind::Rapier {
             dt,
             impulse_step,
             tolerance,
-        } => topple::rapier::chain::run_row(
+        } => topple::rapier::chain::run_row_with_progress(
             row,
             Engine::Rapier,
             SolverSpec {
@@ -157,8 +170,9 @@ fn execute(kind: &RunKind, row: &RowSpec, args: &Args) -> anyhow::Result<ChainRe
                 ..Default::default()
             },
             args.max_time,
+            progress,
         )?,
-        RunKind::Native { dt } => topple::rapier::chain::run_row(
+        RunKind::Native { dt } => topple::rapier::chain::run_row_with_progress(
             row,
             Engine::RapierNative,
             SolverSpec {
@@ -167,6 +181,7 @@ fn execute(kind: &RunKind, row: &RowSpec, args: &Args) -> anyhow::Result<ChainRe
                 ..Default::default()
             },
             args.max_time,
+            progress,
         )?,
     })
 }

@@ -246,7 +246,16 @@ pub fn run(args: Args) -> anyhow::Result<()> {
             max_group_hops: Some(args.window),
             ..Default::default()
         };
-        let report = topple::rapier::chain::run_row(&row, engine, solver, args.max_time)?;
+        let bar = super::blocks_bar(row.n, engine.name());
+        let report = topple::rapier::chain::run_row_with_progress(
+            &row,
+            engine,
+            solver,
+            args.max_time,
+            |hit| bar.set_position(hit as u64),
+        );
+        bar.finish_and_clear();
+        let report = report?;
         if args.json {
             println!("{}", serde_json::to_string_pretty(&report)?);
         } else {
@@ -258,7 +267,11 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         }
         return Ok(());
     }
-    let out = topple::reference::run(&row, &settings)?;
+    let bar = super::blocks_bar(row.n, "reference");
+    let out =
+        topple::reference::run_with_progress(&row, &settings, |hit| bar.set_position(hit as u64));
+    bar.finish_and_clear();
+    let out = out?;
     if let Some(path) = &args.svg {
         let svg = snapshot_svg(&p.block, &out.snapshots, 0, row.n - 1);
         std::fs::write(path, svg).with_context(|| format!("writing {}", path.display()))?;

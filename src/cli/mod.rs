@@ -41,6 +41,20 @@ enum Command {
     Bench(bench::Args),
 }
 
+/// A bar on stderr counting the blocks the wave has hit; indicatif draws it
+/// only when stderr is a terminal, so pipes and captured output stay clean.
+fn blocks_bar(n: usize, label: &str) -> indicatif::ProgressBar {
+    let bar = indicatif::ProgressBar::new(n as u64);
+    bar.set_style(
+        indicatif::ProgressStyle::with_template(
+            "{prefix} {bar:40} {pos}/{len} blocks hit, {elapsed} elapsed, eta {eta}",
+        )
+        .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
+    );
+    bar.set_prefix(label.to_string());
+    bar
+}
+
 /// Parses the command line, runs the subcommand, returns the exit status.
 pub fn run() -> i32 {
     let cli = Cli::parse();

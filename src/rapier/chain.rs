@@ -18,6 +18,18 @@ pub fn run_row(
     solver: SolverSpec,
     max_time: f64,
 ) -> anyhow::Result<ChainReport> {
+    run_row_with_progress(row, engine, solver, max_time, |_| {})
+}
+
+/// [`run_row`], calling `progress` with the number of blocks hit so far each
+/// time the wave reaches another block.
+pub fn run_row_with_progress(
+    row: &RowSpec,
+    engine: Engine,
+    solver: SolverSpec,
+    max_time: f64,
+    mut progress: impl FnMut(usize),
+) -> anyhow::Result<ChainReport> {
     let p = &row.params;
     let scene = Scene {
         description: String::new(),
@@ -61,7 +73,11 @@ pub fn run_row(
     let mut hits = HitTracker::new();
     while hits.hit_times.len() < row.n && sw.time < max_time {
         sw.step()?;
+        let before = hits.hit_times.len();
         hits.update(&sw, sw.time, dt);
+        for hit in before + 1..=hits.hit_times.len() {
+            progress(hit);
+        }
         if sw.time - hits.hit_times.last().copied().unwrap_or(0.0) > 2.0 {
             break;
         }

@@ -770,6 +770,26 @@ impl Engine {
 /// println!("v_na = {:?}", out.report.natural_speed);
 /// ```
 pub fn run(row: &RowSpec, settings: &Settings) -> Result<RunResult, EngineError> {
+    run_with_progress(row, settings, |_| {})
+}
+
+/// [`run`], calling `progress` with the number of blocks hit so far each time
+/// the wave reaches another block (for a progress bar on long rows).
+///
+/// ```
+/// use topple::domino::{Preset, RowSpec};
+/// use topple::reference::{run_with_progress, Settings};
+/// let p = Preset::T.params().ideal();
+/// let row = RowSpec::new(p, 0.5 * p.block.height, 4, 1.0);
+/// let mut seen = Vec::new();
+/// let out = run_with_progress(&row, &Settings::default(), |hit| seen.push(hit)).unwrap();
+/// assert_eq!(seen, (1..=out.report.hit_times.len()).collect::<Vec<_>>());
+/// ```
+pub fn run_with_progress(
+    row: &RowSpec,
+    settings: &Settings,
+    mut progress: impl FnMut(usize),
+) -> Result<RunResult, EngineError> {
     let start = Instant::now();
     let mut e = Engine::new(row, settings)?;
     let t_max = settings
@@ -778,6 +798,7 @@ pub fn run(row: &RowSpec, settings: &Settings) -> Result<RunResult, EngineError>
     e.handle_events()?;
     e.record();
     let mut stopped_early = false;
+    let mut hits_seen = 0;
     while e.lo < e.hi && e.t < t_max {
         if settings.stop_at_last_hit && e.hit[row.n - 1].is_some() {
             break;
@@ -789,6 +810,10 @@ pub fn run(row: &RowSpec, settings: &Settings) -> Result<RunResult, EngineError>
             }
         }
         e.advance(t_max)?;
+        while hits_seen < row.n && e.hit[hits_seen].is_some() {
+            hits_seen += 1;
+            progress(hits_seen);
+        }
     }
     e.sync_out();
     let hits: Vec<f64> = e.hit.iter().map_while(|h| *h).collect();

@@ -51,6 +51,6 @@ mod settings;
 mod snapshot;
 mod stepper;
 
-pub use engine::{run, EngineError, RunResult, Snapshot};
+pub use engine::{run, run_with_progress, EngineError, RunResult, Snapshot};
 pub use settings::{Integrator, Settings};
 pub use snapshot::snapshot_svg;
