@@ -204,8 +204,20 @@ impl Engine {
         let step_limit = |r: &Result<_, crate::impact::ImpactError>| {
             matches!(r, Err(crate::impact::ImpactError::StepLimit { .. }))
         };
-        let mut result = self.solver.solve(&bodies, &contacts, &self.s.impact);
-        if step_limit(&result) && !self.s.impact.e0_hold {
+        // Only e = 0 contacts can be held; with none, a retry would repeat
+        // the same computation.
+        let can_hold =
+            !self.s.impact.e0_hold && contacts.iter().any(|c| c.material.restitution == 0.0);
+        let first = if can_hold {
+            crate::impact::ImpactSettings {
+                max_steps: self.s.held_retry_after.min(self.s.impact.max_steps),
+                ..self.s.impact
+            }
+        } else {
+            self.s.impact
+        };
+        let mut result = self.solver.solve(&bodies, &contacts, &first);
+        if step_limit(&result) && can_hold {
             // The paper's e = 0 law did not finish: a wedged group whose e = 0
             // contacts release and reload in ever smaller cycles. Their limit
             // is a contact held closed, which `e0_hold` solves directly (the
