@@ -469,8 +469,9 @@ impl Engine {
                 y: &self.y,
                 pos: &self.pos,
             };
-            // a search that does not converge keeps its last mode; the events
-            // of the next step correct it
+            // a search that does not converge keeps its last mode minus any
+            // pulling contact (see `select`); the events of the next step
+            // correct it
             let _ = select(
                 &mut self.dynamics,
                 &self.rc,

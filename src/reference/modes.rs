@@ -37,7 +37,8 @@ fn initial_mode(rc: &RowConst, slot: usize, vt: f64, tol: &ModeTol) -> Mode {
 
 /// Finds the mode; `out` receives the pressing contacts, in candidate order
 /// (which must be sorted by block). Returns false if no consistent mode was
-/// found within the iteration limit (the last one tried is kept).
+/// found within the iteration limit: the last one tried is kept, less the
+/// contacts whose normal force pulls (they lift off).
 pub(crate) fn select(
     dyn_: &mut Dynamics,
     rc: &RowConst,
@@ -123,6 +124,23 @@ pub(crate) fn select(
             }
         } else {
             state[ci] = next;
+        }
+    }
+    // No consistent mode (the search cycles, as frictional contact problems
+    // can). Never keep a contact that pulls: a pulling contact would call
+    // for a lift-off event at every step and stall the run. Let such
+    // contacts lift off (if they then close again, that is an event) and
+    // keep the rest of the last mode.
+    for _ in 0..out.len() {
+        let Some(worst) = (0..out.len())
+            .filter(|&k| dyn_.fn_[k] < -tol.force)
+            .min_by(|&a, &b| dyn_.fn_[a].total_cmp(&dyn_.fn_[b]))
+        else {
+            break;
+        };
+        out.remove(worst);
+        if !dyn_.forces(rc, view, out) {
+            break;
         }
     }
     false
