@@ -42,18 +42,18 @@ fn heel_contacts_keep_sliding_blocks_apart() {
     assert!(e.residual.abs() < 1e-6 * e.initial, "{e:?}");
 }
 
-/// On an ideal row the heel contact closes face to face with the block
-/// behind, and the contact mode search can cycle there. It used to keep a
-/// pulling contact, whose lift-off event then fired at every step and stalled
-/// the run; now such contacts lift off. The row must run to its end, keep
-/// the blocks apart, and agree with the row without heel contacts (measured
-/// 1.7697 against 1.7760 on 20 blocks; 30 blocks of the ideal row lie within
-/// 2.6 % of the cooperative model, see reference_wave.rs).
+/// On a long Table 1 row at small spacing the heel contacts close face to
+/// face with the block behind, and the contact-mode search can cycle there.
+/// It used to keep a contact pulling with −9.3 N, whose lift-off event then
+/// fired at every step: this 30-block row did not finish in 300 s. Now such
+/// contacts lift off; the row must run to its end (measured 17 s), keep the
+/// blocks apart, and agree with the row without heel contacts (measured
+/// 1.6956 against 1.6969).
 #[test]
-fn heel_contacts_run_the_ideal_row() {
-    let p = Preset::T.params().ideal();
+fn heel_contacts_run_a_long_small_spacing_row() {
+    let p = Preset::X.params();
     let h = p.block.height;
-    let row = RowSpec::new(p, 0.45 * h, 20, 1.0);
+    let row = RowSpec::new(p, 0.18 * h, 30, 1.0);
     let with = run(
         &row,
         &Settings {
@@ -65,7 +65,7 @@ fn heel_contacts_run_the_ideal_row() {
     .unwrap()
     .report;
     assert!(!with.stopped_early, "the run stalled");
-    assert_eq!(with.hit_times.len(), 20);
+    assert_eq!(with.hit_times.len(), 30);
     assert!(with.max_penetration.unwrap() < 0.005 * h);
     let without = run(&row, &Settings::default()).unwrap().report;
     let (a, b) = (with.natural_speed.unwrap(), without.natural_speed.unwrap());
