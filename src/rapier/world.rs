@@ -6,8 +6,8 @@ use rapier2d_f64::parry::query::{
     ContactManifold, DefaultQueryDispatcher, PersistentQueryDispatcher,
 };
 use rapier2d_f64::prelude::{
-    ActiveHooks, ColliderHandle, ColliderSet, NarrowPhase, PhysicsWorld, RigidBodyHandle,
-    RigidBodySet, Vector,
+    ActiveHooks, ColliderHandle, ColliderSet, NarrowPhase, PhysicsWorld, RigidBody,
+    RigidBodyHandle, RigidBodySet, Vector,
 };
 
 use crate::impact::{Body, ImpactError};
@@ -81,6 +81,8 @@ pub struct ToppleRapier {
     manifold: ContactManifold<(), ()>,
     points: Vec<ManifoldPoint>,
     closed_now: Vec<u64>,
+    /// Sleeping bodies given a slot in this pass (only they need expanding).
+    sleeping_slots: usize,
     reports: Vec<ImpactReport>,
     stats: ToppleStats,
 }
@@ -91,6 +93,11 @@ const NO_SLOT: u32 = u32::MAX;
 pub(crate) fn pair_key(a: ColliderHandle, b: ColliderHandle) -> u64 {
     let (a, b) = (a.into_raw_parts().0 as u64, b.into_raw_parts().0 as u64);
     (a.min(b) << 32) | a.max(b)
+}
+
+/// A dynamic body Rapier integrates this step.
+fn is_awake(rb: &RigidBody) -> bool {
+    rb.is_dynamic() && !rb.is_sleeping()
 }
 
 fn v2(v: Vector) -> [f64; 2] {
@@ -122,6 +129,7 @@ impl ToppleRapier {
             manifold: ContactManifold::new(),
             points: Vec::new(),
             closed_now: Vec::new(),
+            sleeping_slots: 0,
             reports: Vec::new(),
             stats: ToppleStats::default(),
         }
@@ -212,6 +220,7 @@ impl ToppleRapier {
         }
         if self.slot[i] == NO_SLOT {
             self.slot[i] = self.bodies.len() as u32;
+            self.sleeping_slots += rb.is_sleeping() as usize;
             let inv_i = rb.mass_properties().effective_world_inv_inertia;
             self.bodies.push(Body {
                 mass: rb.mass(),
@@ -264,8 +273,7 @@ impl ToppleRapier {
                         .copied()
                         .unwrap_or(NO_SLOT);
                     // awake: queried in the first pass; expanded: queried then
-                    (rb.is_dynamic() && !rb.is_sleeping())
-                        || (slot != NO_SLOT && (slot as usize) < k)
+                    is_awake(rb) || (slot != NO_SLOT && (slot as usize) < k)
                 });
                 if !skip {
                     self.query_pair(pair.collider1, pair.collider2, bodies, colliders);
@@ -368,10 +376,9 @@ impl ToppleRapier {
         self.handles.clear();
         self.contacts.clear();
         self.closed_now.clear();
-        let awake = |h: Option<RigidBodyHandle>| {
-            h.and_then(|h| bodies.get(h))
-                .is_some_and(|rb| rb.is_dynamic() && !rb.is_sleeping())
-        };
+        self.sleeping_slots = 0;
+        let awake =
+            |h: Option<RigidBodyHandle>| h.and_then(|h| bodies.get(h)).is_some_and(is_awake);
         for pair in narrow_phase.contact_pairs() {
             let (Some(co1), Some(co2)) =
                 (colliders.get(pair.collider1), colliders.get(pair.collider2))
@@ -389,11 +396,14 @@ impl ToppleRapier {
         // then those they touch, as far as the impact window reaches; a pair
         // of two sleeping bodies is queried once, by the one expanded first.
         // Sleeping bodies found beyond the window stay where they are (fixed).
-        let has_seed = self
-            .contacts
-            .iter()
-            .any(|c| seed_approach(&self.bodies, c, &self.settings).is_some());
-        if has_seed {
+        // (The seed scan is repeated by `ImpactGroups::resolve`; it is done
+        // here only when a sleeping body was touched, which is rare.)
+        let expand = self.sleeping_slots > 0
+            && self
+                .contacts
+                .iter()
+                .any(|c| seed_approach(&self.bodies, c, &self.settings).is_some());
+        if expand {
             let generations = self.settings.max_group_hops.map_or(usize::MAX, |h| h + 1);
             let (mut next, mut generation) = (0, 0);
             while next < self.handles.len() && generation < generations {
@@ -429,7 +439,7 @@ impl ToppleRapier {
                 let asleep = |co: Option<&rapier2d_f64::prelude::Collider>| {
                     co.and_then(|co| co.parent())
                         .and_then(|h| bodies.get(h))
-                        .is_none_or(|rb| !rb.is_dynamic() || rb.is_sleeping())
+                        .is_none_or(|rb| !is_awake(rb))
                 };
                 asleep(c(a)) && asleep(c(b))
             });
