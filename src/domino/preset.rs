@@ -77,8 +77,9 @@ pub struct RowParams {
     pub lambda_points: usize,
     /// Exponent α of the contact law F = k(−δ)^α (the paper uses 1.5).
     pub alpha: f64,
-    /// Factor on both friction coefficients inside impacts (Table 1 footnote,
-    /// errata §4: 0.5).
+    /// Factor on the sliding friction coefficients μ1, μ2 inside impacts
+    /// (Table 1 footnote, errata §4: 0.5); the sticking coefficients are not
+    /// scaled.
     pub impact_friction_factor: f64,
     /// Gravity g (m/s²).
     pub gravity: f64,

@@ -65,8 +65,12 @@ impl Engine {
             stiffness: k,
             exponent: p.alpha,
             restitution: e,
+            // Only the sliding coefficient is scaled (Table 1's footnote:
+            // "the coefficient of sliding friction in impact"; errata §4);
+            // a contact stuck at the start of an impulse step stays stuck
+            // while that needs |dP_t| ≤ μ_s dP_n with the table's μ_s.
             friction: f * mu,
-            stick_friction: f * mus,
+            stick_friction: mus,
         }
     }
 
