@@ -10,15 +10,39 @@
 use super::dynamics::{Active, Mode};
 use super::engine::{Engine, EngineError};
 use super::geometry::{surface, Surface};
-use crate::impact::{Body, Contact, ContactMaterial};
+use crate::impact::{Body, Contact, ContactMaterial, ImpactOutcome};
+
+/// Buffers of [`Engine::resolve_impacts`], kept between impacts so that a
+/// long row allocates nothing per impact once they have grown.
+#[derive(Debug, Default)]
+pub(crate) struct ImpactBuffers {
+    /// Closed contacts approaching faster than the approach tolerance.
+    approaching: Vec<(usize, usize)>,
+    /// Every closed contact (block, slot) of the window.
+    closed: Vec<(usize, usize)>,
+    /// Window block b linked to b + 1 by a closed contact.
+    linked: Vec<bool>,
+    /// Window block b takes part in the impact.
+    in_group: Vec<bool>,
+    /// Window block b → its index among `bodies`.
+    index: Vec<usize>,
+    bodies: Vec<Body>,
+    /// Row index of each of `bodies`.
+    members: Vec<usize>,
+    contacts: Vec<Contact>,
+    outcome: ImpactOutcome,
+    plastic: Vec<Active>,
+}
 
 impl Engine {
-    fn plastic_impact(&mut self, closed: &[(usize, usize)], in_group: &[bool]) {
+    fn plastic_impact(&mut self, buf: &mut ImpactBuffers) {
         let lambda = self.rc.p.lambda_points;
         let (lo, hi) = (self.lo, self.hi);
+        let in_group = &buf.in_group;
         let member = |j: usize| j >= lo && j < hi && in_group[j - lo];
-        let mut act: Vec<Active> = Vec::new();
-        for &(i, slot) in closed {
+        let act = &mut buf.plastic;
+        act.clear();
+        for &(i, slot) in &buf.closed {
             let inside = if slot <= lambda {
                 member(i)
             } else {
@@ -38,15 +62,8 @@ impl Engine {
             }
         }
         let before = self.window_energy();
-        self.dynamics.project(
-            &self.rc,
-            lo,
-            hi,
-            &mut self.y,
-            &self.pos,
-            &mut act,
-            self.v_tol,
-        );
+        self.dynamics
+            .project(&self.rc, lo, hi, &mut self.y, &self.pos, act, self.v_tol);
         let after = self.window_energy();
         self.energy.impacts += before - after;
         self.impacts += 1;
@@ -76,12 +93,18 @@ impl Engine {
 
     /// Resolves the impacts present now, if any. Returns whether there was one.
     pub(crate) fn resolve_impacts(&mut self) -> Result<bool, EngineError> {
+        let mut buf = std::mem::take(&mut self.impact_buffers);
+        let result = self.resolve_impacts_with(&mut buf);
+        self.impact_buffers = buf;
+        result
+    }
+
+    fn resolve_impacts_with(&mut self, buf: &mut ImpactBuffers) -> Result<bool, EngineError> {
         // 1. approaching closed contacts; wake the frozen blocks they strike
         let mut woke = true;
-        let mut approaching: Vec<(usize, usize)> = Vec::new();
         while woke {
             woke = false;
-            approaching.clear();
+            buf.approaching.clear();
             let view = self.view();
             let (mut new_lo, mut new_hi) = (self.lo, self.hi);
             self.for_each_slot(|i, slot| {
@@ -93,7 +116,7 @@ impl Engine {
                 }
                 let k = self.rc.kin(&view, &g);
                 if k.gdot < -self.v_app {
-                    approaching.push((i, slot));
+                    buf.approaching.push((i, slot));
                     for b in [Some(g.corner), g.face].into_iter().flatten() {
                         if b < self.lo {
                             new_lo = new_lo.min(b);
@@ -112,57 +135,60 @@ impl Engine {
                 woke = true;
             }
         }
-        if approaching.is_empty() {
+        if buf.approaching.is_empty() {
             return Ok(false);
         }
         // 2. the group: runs of moving blocks linked by closed contacts
         let lambda = self.rc.p.lambda_points;
         let nb = self.hi - self.lo;
         let view = self.view();
-        let mut linked = vec![false; nb]; // block lo+b linked to lo+b+1
-        let mut closed: Vec<(usize, usize)> = Vec::new();
+        buf.linked.clear();
+        buf.linked.resize(nb, false);
+        buf.closed.clear();
         self.for_each_slot(|i, slot| {
             let Some(g) = self.rc.geom(&view, i, slot) else {
                 return;
             };
             if g.valid && g.gap <= self.eps_gap {
-                closed.push((i, slot));
+                buf.closed.push((i, slot));
                 if slot > lambda && i >= self.lo && i + 1 < self.hi {
-                    linked[i - self.lo] = true;
+                    buf.linked[i - self.lo] = true;
                 }
             }
         });
-        let mut in_group = vec![false; nb];
-        for &(i, slot) in &approaching {
+        buf.in_group.clear();
+        buf.in_group.resize(nb, false);
+        for &(i, slot) in &buf.approaching {
             let g = self.rc.geom(&view, i, slot).expect("slot exists");
             for b in [Some(g.corner), g.face].into_iter().flatten() {
                 if b >= self.lo && b < self.hi {
-                    in_group[b - self.lo] = true;
+                    buf.in_group[b - self.lo] = true;
                 }
             }
         }
         // spread along links (both directions)
         for b in 0..nb.saturating_sub(1) {
-            if in_group[b] && linked[b] {
-                in_group[b + 1] = true;
+            if buf.in_group[b] && buf.linked[b] {
+                buf.in_group[b + 1] = true;
             }
         }
         for b in (0..nb.saturating_sub(1)).rev() {
-            if in_group[b + 1] && linked[b] {
-                in_group[b] = true;
+            if buf.in_group[b + 1] && buf.linked[b] {
+                buf.in_group[b] = true;
             }
         }
         // 3. bodies and contacts
         let p = self.rc.p;
-        let mut index = vec![usize::MAX; nb];
-        let mut bodies: Vec<Body> = Vec::new();
-        let mut members: Vec<usize> = Vec::new();
+        buf.index.clear();
+        buf.index.resize(nb, usize::MAX);
+        buf.bodies.clear();
+        buf.members.clear();
         for b in 0..nb {
-            if in_group[b] {
-                index[b] = bodies.len();
+            if buf.in_group[b] {
+                buf.index[b] = buf.bodies.len();
                 let i = self.lo + b;
                 let (q, v) = self.state(i);
-                bodies.push(Body {
+                buf.bodies.push(Body {
                     mass: p.block.mass,
                     inertia: p.block.inertia(),
                     position: [q[0], q[1]],
@@ -171,19 +197,21 @@ impl Engine {
                     angular_velocity: v[2],
                     fixed: false,
                 });
-                members.push(i);
+                buf.members.push(i);
             }
         }
+        let (lo, hi) = (self.lo, self.hi);
+        let (in_group, index) = (&buf.in_group, &buf.index);
         let to_body = |j: Option<usize>| -> Option<usize> {
             let j = j?;
-            if j >= self.lo && j < self.hi && in_group[j - self.lo] {
-                Some(index[j - self.lo])
+            if j >= lo && j < hi && in_group[j - lo] {
+                Some(index[j - lo])
             } else {
                 None
             }
         };
-        let mut contacts: Vec<Contact> = Vec::new();
-        for &(i, slot) in &closed {
+        buf.contacts.clear();
+        for &(i, slot) in &buf.closed {
             let g = self.rc.geom(&view, i, slot).expect("slot exists");
             let a = to_body(Some(g.corner));
             let f = to_body(g.face);
@@ -194,24 +222,24 @@ impl Engine {
             // fixed wall can wedge a block between it and the ground so that no
             // finite impulse ends the impact; the tail behind the wave is at
             // rest and would take a negligible share anyway.
-            let frozen = |j: usize| j < self.lo || j >= self.hi;
+            let frozen = |j: usize| j < lo || j >= hi;
             if frozen(g.corner) || g.face.is_some_and(frozen) {
                 continue;
             }
-            contacts.push(Contact {
+            buf.contacts.push(Contact {
                 bodies: [f, a],
                 point: g.point,
                 normal: g.normal,
                 material: self.material(slot),
             });
         }
-        let step_limit = |r: &Result<_, crate::impact::ImpactError>| {
+        let step_limit = |r: &Result<(), crate::impact::ImpactError>| {
             matches!(r, Err(crate::impact::ImpactError::StepLimit { .. }))
         };
         // Only e = 0 contacts can be held; with none, a retry would repeat
         // the same computation.
         let can_hold =
-            !self.s.impact.e0_hold && contacts.iter().any(|c| c.material.restitution == 0.0);
+            !self.s.impact.e0_hold && buf.contacts.iter().any(|c| c.material.restitution == 0.0);
         let first = if can_hold {
             crate::impact::ImpactSettings {
                 max_steps: self.s.held_retry_after.min(self.s.impact.max_steps),
@@ -220,7 +248,9 @@ impl Engine {
         } else {
             self.s.impact
         };
-        let mut result = self.solver.solve(&bodies, &contacts, &first);
+        let mut result =
+            self.solver
+                .solve_into(&buf.bodies, &buf.contacts, &first, &mut buf.outcome);
         if step_limit(&result) && can_hold {
             // The paper's e = 0 law did not finish: a wedged group whose e = 0
             // contacts release and reload in ever smaller cycles. Their limit
@@ -230,19 +260,21 @@ impl Engine {
                 e0_hold: true,
                 ..self.s.impact
             };
-            result = self.solver.solve(&bodies, &contacts, &held);
+            result = self
+                .solver
+                .solve_into(&buf.bodies, &buf.contacts, &held, &mut buf.outcome);
             if result.is_ok() {
                 self.held_impacts += 1;
             }
         }
-        let out = match result {
-            Ok(out) => out,
+        match result {
+            Ok(()) => {}
             Err(_) if step_limit(&result) => {
                 // Still unfinished: resolve this one as a plastic impact, the
                 // smallest velocity change (in kinetic-energy norm) that
                 // leaves no closed contact of the group approaching. Counted
                 // in the report as a fallback.
-                self.plastic_impact(&closed, &in_group);
+                self.plastic_impact(buf);
                 return Ok(true);
             }
             Err(source) => {
@@ -251,10 +283,11 @@ impl Engine {
                     source,
                 })
             }
-        };
+        }
+        let out = &buf.outcome;
         self.impacts += 1;
         self.energy.impacts += out.kinetic_energy_before - out.kinetic_energy_after;
-        for (k, &i) in members.iter().enumerate() {
+        for (k, &i) in buf.members.iter().enumerate() {
             let bv = out.bodies[k];
             let off = 6 * (i - self.lo) + 3;
             self.y[off] = bv.velocity[0];
