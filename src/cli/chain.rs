@@ -134,8 +134,8 @@ pub struct Args {
     #[arg(long)]
     pub freeze_tolerance: Option<f64>,
     /// Reference engine: make the heel of every block a contact on the front
-    /// face of the block behind (no overlap where blocks slide back; stalls on
-    /// ideal rows, see README).
+    /// face of the block behind (no overlap where blocks slide back; about
+    /// twice the run time, see README).
     #[arg(long)]
     pub heel_contacts: bool,
     /// Print the report as JSON.

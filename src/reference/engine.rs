@@ -8,7 +8,7 @@ use std::time::Instant;
 
 use super::dynamics::{Active, Dynamics, Mode, RowConst, View};
 use super::geometry::slots_per_block;
-use super::modes::{select, Candidate, ModeTol};
+use super::modes::{initial_mode, select, Candidate, ModeTol};
 use super::settings::{Integrator, Settings};
 use super::stepper::{Stages, DOPRI5, HEUN};
 use crate::domino::{BlockSeries, ChainReport, EnergyReport, RowSpec};
@@ -86,6 +86,10 @@ pub(crate) struct Engine {
     pub impact_fallbacks: usize,
     pub held_impacts: usize,
     pub reversed: Vec<bool>,
+    /// Time (s) of the last impact, and how many `handle_events` calls in a
+    /// row have found an impact at that same instant.
+    last_impact_time: f64,
+    impacts_at_this_instant: usize,
     pub steps: usize,
     pub evaluations: usize,
     // event references, per active contact
@@ -176,6 +180,8 @@ impl Engine {
             impact_fallbacks: 0,
             held_impacts: 0,
             reversed: vec![false; n],
+            last_impact_time: f64::NEG_INFINITY,
+            impacts_at_this_instant: 0,
             steps: 0,
             evaluations: 0,
             ref_fn: Vec::new(),
@@ -425,10 +431,20 @@ impl Engine {
     /// Impacts, contact mode, projection; then the derivative for the next step.
     fn handle_events(&mut self) -> Result<(), EngineError> {
         self.sync_out();
+        let mut impacted = false;
         for _ in 0..20 {
             if !self.resolve_impacts()? {
                 break;
             }
+            impacted = true;
+        }
+        if impacted {
+            if self.t - self.last_impact_time <= self.s.event_time_tolerance {
+                self.impacts_at_this_instant += 1;
+            } else {
+                self.impacts_at_this_instant = 0;
+            }
+            self.last_impact_time = self.t;
         }
         self.record_hits();
         // candidates: closed, valid, neither approaching nor separating
@@ -486,8 +502,77 @@ impl Engine {
         }
         self.candidates = cands;
         self.set_active();
-        self.project();
+        if self.impacts_at_this_instant >= 2 {
+            self.project_unilateral();
+        } else {
+            self.project();
+        }
         self.eval_k0()
+    }
+
+    /// [`Engine::project`], then the closed contacts left out of the active
+    /// set that the projection drives into approach join it and the
+    /// projection is repeated from the same state: the velocities end on
+    /// {active: δ̇ = 0, other closed contacts: δ̇ ≥ 0}.
+    ///
+    /// Used once impacts repeat at one instant (`handle_events`): a
+    /// face-to-face pair (B_i and the heel contact closed together) can
+    /// cycle there. The impact leaves the heel separating at 10⁻⁷ m/s, the
+    /// mode search (acceleration level) does not need it, the projection of
+    /// B_i turns the pair so that the heel approaches at 4·10⁻⁵ m/s, and the
+    /// impact that follows at the same instant starts the cycle again (ideal
+    /// Domino T rows with `heel_contacts`). Not used otherwise: where blocks
+    /// chatter at the back of a Table 1 row, contacts joined this way are
+    /// dropped by the next mode search and joined again thousands of times.
+    fn project_unilateral(&mut self) {
+        let start = self.y.clone();
+        let booked = self.energy.projection;
+        for _ in 0..4 {
+            self.project();
+            let mut joined = std::mem::take(&mut self.new_active);
+            joined.clear();
+            {
+                let view = self.view();
+                let (rc, tol, eps, vapp) = (&self.rc, &self.tol, self.eps_gap, self.v_app);
+                let k = self.k_slots;
+                let is_active = &self.is_active;
+                self.for_each_slot(|i, slot| {
+                    if is_active[i * k + slot] {
+                        return;
+                    }
+                    let Some(g) = rc.geom(&view, i, slot) else {
+                        return;
+                    };
+                    if !g.valid || g.gap > eps {
+                        return;
+                    }
+                    if view.local(Some(g.corner)).is_none()
+                        || (g.face.is_some() && view.local(g.face).is_none())
+                    {
+                        return;
+                    }
+                    let kk = rc.kin(&view, &g);
+                    if kk.gdot < -vapp {
+                        joined.push(Active {
+                            block: i,
+                            slot,
+                            mode: initial_mode(rc, slot, kk.vt, tol),
+                        });
+                    }
+                });
+            }
+            if joined.is_empty() {
+                self.new_active = joined;
+                break;
+            }
+            joined.extend_from_slice(&self.active);
+            // the band solve wants the contacts sorted by block
+            joined.sort_by_key(|a| (a.block, a.slot));
+            self.new_active = joined;
+            self.set_active();
+            self.y.copy_from_slice(&start);
+            self.energy.projection = booked;
+        }
     }
 
     /// Projection onto the active constraints, with its energy change booked.

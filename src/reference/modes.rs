@@ -24,7 +24,7 @@ pub(crate) struct ModeTol {
     pub velocity: f64,
 }
 
-fn initial_mode(rc: &RowConst, slot: usize, vt: f64, tol: &ModeTol) -> Mode {
+pub(crate) fn initial_mode(rc: &RowConst, slot: usize, vt: f64, tol: &ModeTol) -> Mode {
     let (mu, mus) = rc.mu(slot);
     if vt.abs() <= tol.velocity && mus > 0.0 {
         Mode::Stick
