@@ -6,7 +6,7 @@ use std::path::PathBuf;
 use anyhow::Context;
 
 use topple::domino::{Preset, RowParams, RowSpec};
-use topple::reference::{snapshot_svg, Integrator, Settings};
+use topple::reference::{snapshot_png, snapshot_svg, Integrator, Settings};
 
 /// Block type of Table 1.
 #[derive(Clone, Copy, Debug, clap::ValueEnum)]
@@ -144,12 +144,15 @@ pub struct Args {
     /// Record θ and θ̇ of these blocks (1-based, comma-separated).
     #[arg(long, value_delimiter = ',')]
     pub series: Vec<usize>,
-    /// Write snapshots of the row at these times (s) to --svg.
+    /// Draw the row at these times (s) into --svg and/or --png.
     #[arg(long, value_delimiter = ',')]
     pub snapshots: Vec<f64>,
     /// SVG file for the snapshots.
     #[arg(long)]
     pub svg: Option<PathBuf>,
+    /// PNG file for the snapshots (same drawing, 4 px per mm, no labels).
+    #[arg(long)]
+    pub png: Option<PathBuf>,
 }
 
 /// Row parameters from a preset and the overrides.
@@ -230,12 +233,34 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     settings.heel_contacts = args.heel_contacts;
     settings.series_blocks = args.series.clone();
     settings.snapshot_times = args.snapshots.clone();
+    let drawing = args.svg.is_some() || args.png.is_some();
+    anyhow::ensure!(
+        args.snapshots.is_empty() || drawing,
+        "--snapshots needs --svg FILE or --png FILE to draw them into"
+    );
+    anyhow::ensure!(
+        !drawing || !args.snapshots.is_empty(),
+        "--svg and --png draw the times given by --snapshots T1,T2,…"
+    );
+    anyhow::ensure!(
+        args.series.iter().all(|&b| b >= 1 && b <= row.n),
+        "--series takes block numbers from 1 to {}",
+        row.n
+    );
+    anyhow::ensure!(
+        args.snapshots.iter().all(|t| t.is_finite() && *t >= 0.0),
+        "--snapshots takes times in seconds, ≥ 0"
+    );
     let rapier_engine = match args.engine {
         EngineArg::Reference => None,
         EngineArg::Rapier => Some(topple::rapier::scene::Engine::Rapier),
         EngineArg::RapierNative => Some(topple::rapier::scene::Engine::RapierNative),
     };
     if let Some(engine) = rapier_engine {
+        anyhow::ensure!(
+            !drawing && args.series.is_empty(),
+            "--snapshots, --svg, --png and --series are for the reference engine"
+        );
         anyhow::ensure!(
             args.dt > 0.0 && args.dt.is_finite(),
             "--dt must be a positive time step"
@@ -275,6 +300,11 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     if let Some(path) = &args.svg {
         let svg = snapshot_svg(&p.block, &out.snapshots, 0, row.n - 1);
         std::fs::write(path, svg).with_context(|| format!("writing {}", path.display()))?;
+    }
+    if let Some(path) = &args.png {
+        let png = snapshot_png(&p.block, &out.snapshots, 0, row.n - 1, 4.0)
+            .with_context(|| format!("encoding {}", path.display()))?;
+        std::fs::write(path, png).with_context(|| format!("writing {}", path.display()))?;
     }
     let r = &out.report;
     if args.json {

@@ -53,4 +53,4 @@ mod stepper;
 
 pub use engine::{run, run_with_progress, EngineError, RunResult, Snapshot};
 pub use settings::{Integrator, Settings};
-pub use snapshot::snapshot_svg;
+pub use snapshot::{snapshot_png, snapshot_svg, PNG_BLOCK};
