@@ -96,6 +96,10 @@ pub(crate) struct Dynamics {
     pub gap: Vec<f64>,
     /// Whether each active contact still projects onto its face.
     pub valid: Vec<bool>,
+    // buffers of `project`
+    proj_start: Vec<f64>,
+    proj_owner: Vec<(usize, bool)>,
+    proj_drop: Vec<usize>,
 }
 
 /// Constants of the row needed by the dynamics.
@@ -345,7 +349,32 @@ impl Dynamics {
         active: &mut Vec<Active>,
         v_tol: f64,
     ) {
-        let mut y0: Vec<f64> = Vec::new();
+        // buffers kept between calls: this runs every step
+        let mut y0 = std::mem::take(&mut self.proj_start);
+        let mut owner = std::mem::take(&mut self.proj_owner);
+        let mut drop = std::mem::take(&mut self.proj_drop);
+        self.project_with(
+            rc, lo, hi, y, pos, active, v_tol, &mut y0, &mut owner, &mut drop,
+        );
+        self.proj_start = y0;
+        self.proj_owner = owner;
+        self.proj_drop = drop;
+    }
+
+    #[allow(clippy::too_many_arguments)]
+    fn project_with(
+        &mut self,
+        rc: &RowConst,
+        lo: usize,
+        hi: usize,
+        y: &mut [f64],
+        pos: &[[f64; 3]],
+        active: &mut Vec<Active>,
+        v_tol: f64,
+        y0: &mut Vec<f64>,
+        owner: &mut Vec<(usize, bool)>,
+        drop: &mut Vec<usize>,
+    ) {
         for pass in 0..2 {
             let mut rounds = 0;
             loop {
@@ -358,12 +387,12 @@ impl Dynamics {
                         y0.clear();
                         y0.extend_from_slice(y);
                     } else {
-                        y.copy_from_slice(&y0);
+                        y.copy_from_slice(y0);
                     }
                 }
                 self.unknowns.clear();
                 self.band.rhs.clear();
-                let mut owner: Vec<(usize, bool)> = Vec::new();
+                owner.clear();
                 {
                     let view = View { lo, hi, y, pos };
                     for (c, a) in active.iter().enumerate() {
@@ -406,16 +435,18 @@ impl Dynamics {
                     // velocity tolerance (a small pull is the persistence of a
                     // contact that separates slower than that)
                     let pull = 2.0 * rc.p.block.mass * v_tol;
-                    let mut drop: Vec<usize> = owner
-                        .iter()
-                        .zip(self.band.rhs.iter())
-                        .filter(|((_, normal), p)| *normal && **p < -pull)
-                        .map(|((c, _), _)| *c)
-                        .collect();
+                    drop.clear();
+                    drop.extend(
+                        owner
+                            .iter()
+                            .zip(self.band.rhs.iter())
+                            .filter(|((_, normal), p)| *normal && **p < -pull)
+                            .map(|((c, _), _)| *c),
+                    );
                     if !drop.is_empty() {
                         drop.sort_unstable();
                         drop.dedup();
-                        for c in drop.into_iter().rev() {
+                        for &c in drop.iter().rev() {
                             active.remove(c);
                         }
                         continue;
