@@ -7,7 +7,7 @@
 use std::time::Instant;
 
 use super::dynamics::{Active, Dynamics, Mode, RowConst, View};
-use super::geometry::slots_per_block;
+use super::geometry::{slots_per_block, Geom, Kin};
 use super::modes::{initial_mode, select, Candidate, ModeTol};
 use super::settings::{Integrator, Settings};
 use super::stepper::{Stages, DOPRI5, HEUN};
@@ -109,6 +109,28 @@ pub(crate) struct Engine {
     snapshots: Vec<Snapshot>,
     next_snapshot: usize,
     h_adapt: f64,
+}
+
+/// Slot `slot` of block `i` if it is a closed contact (gap ≤ `eps`, m)
+/// between moving blocks, with its kinematics. Contacts with a frozen block
+/// never press: a moving block that approaches a frozen one starts an
+/// impact, which wakes it.
+fn closed_between_moving(
+    rc: &RowConst,
+    view: &View,
+    i: usize,
+    slot: usize,
+    eps: f64,
+) -> Option<(Geom, Kin)> {
+    let g = rc.geom(view, i, slot)?;
+    if !g.valid || g.gap > eps {
+        return None;
+    }
+    if view.local(Some(g.corner)).is_none() || (g.face.is_some() && view.local(g.face).is_none()) {
+        return None;
+    }
+    let k = rc.kin(view, &g);
+    Some((g, k))
 }
 
 fn rhs(
@@ -457,20 +479,9 @@ impl Engine {
             let vt = self.v_tol;
             let vapp = self.v_app;
             self.for_each_slot(|i, slot| {
-                let Some(g) = rc.geom(&view, i, slot) else {
+                let Some((_, k)) = closed_between_moving(rc, &view, i, slot, eps) else {
                     return;
                 };
-                if !g.valid || g.gap > eps {
-                    return;
-                }
-                // contacts with a frozen block never press: a moving block that
-                // approaches a frozen one starts an impact, which wakes it
-                if view.local(Some(g.corner)).is_none()
-                    || (g.face.is_some() && view.local(g.face).is_none())
-                {
-                    return;
-                }
-                let k = rc.kin(&view, &g);
                 if k.gdot >= -vapp && k.gdot <= vt {
                     cands.push(Candidate {
                         block: i,
@@ -540,18 +551,9 @@ impl Engine {
                     if is_active[i * k + slot] {
                         return;
                     }
-                    let Some(g) = rc.geom(&view, i, slot) else {
+                    let Some((_, kk)) = closed_between_moving(rc, &view, i, slot, eps) else {
                         return;
                     };
-                    if !g.valid || g.gap > eps {
-                        return;
-                    }
-                    if view.local(Some(g.corner)).is_none()
-                        || (g.face.is_some() && view.local(g.face).is_none())
-                    {
-                        return;
-                    }
-                    let kk = rc.kin(&view, &g);
                     if kk.gdot < -vapp {
                         joined.push(Active {
                             block: i,
