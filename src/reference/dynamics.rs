@@ -353,41 +353,19 @@ impl Dynamics {
         let mut y0 = std::mem::take(&mut self.proj_start);
         let mut owner = std::mem::take(&mut self.proj_owner);
         let mut drop = std::mem::take(&mut self.proj_drop);
-        self.project_with(
-            rc, lo, hi, y, pos, active, v_tol, &mut y0, &mut owner, &mut drop,
-        );
-        self.proj_start = y0;
-        self.proj_owner = owner;
-        self.proj_drop = drop;
-    }
-
-    #[allow(clippy::too_many_arguments)]
-    fn project_with(
-        &mut self,
-        rc: &RowConst,
-        lo: usize,
-        hi: usize,
-        y: &mut [f64],
-        pos: &[[f64; 3]],
-        active: &mut Vec<Active>,
-        v_tol: f64,
-        y0: &mut Vec<f64>,
-        owner: &mut Vec<(usize, bool)>,
-        drop: &mut Vec<usize>,
-    ) {
-        for pass in 0..2 {
+        'passes: for pass in 0..2 {
             let mut rounds = 0;
             loop {
                 rounds += 1;
                 if active.is_empty() {
-                    return;
+                    break 'passes;
                 }
                 if pass == 0 {
                     if rounds == 1 {
                         y0.clear();
                         y0.extend_from_slice(y);
                     } else {
-                        y.copy_from_slice(y0);
+                        y.copy_from_slice(&y0);
                     }
                 }
                 self.unknowns.clear();
@@ -423,11 +401,11 @@ impl Dynamics {
                     }
                 }
                 if self.unknowns.is_empty() {
-                    return;
+                    break 'passes;
                 }
                 self.assemble(rc);
                 if !self.band.solve() {
-                    return;
+                    break 'passes;
                 }
                 if pass == 0 && rounds < 20 {
                     // drop the contacts that would be pulled together by more
@@ -466,5 +444,8 @@ impl Dynamics {
                 break;
             }
         }
+        self.proj_start = y0;
+        self.proj_owner = owner;
+        self.proj_drop = drop;
     }
 }
