@@ -8,15 +8,27 @@
 //! | layer | what it holds |
 //! | --- | --- |
 //! | [`impact`] | the LZB resolver: bodies + contacts in, post-impact velocities out |
+//! | [`coupling`] | engine-agnostic: materials, λ-point patches, impact groups, the fallback policy |
 //! | [`domino`] | block geometry, Table 1 presets, row builder, wave-speed measures |
 //! | [`theory`] | cooperative, extended and single-collision models of the wave |
 //! | [`reference`] | the paper's reduced-coordinate domino model (the accuracy oracle) |
-//! | [`rapier`] | the plugin for `rapier2d-f64` |
+//! | [`rapier`] | the plugin for Rapier, one source for `rapier2d-f64` and `rapier2d` (f32) |
 //!
 //! Data flows down the table: a module uses the ones above it, never one below.
+//! The Rapier crates topple is built against are re-exported, so a user does
+//! not have to spell their pre-release versions: [`rapier2d_f64`] and
+//! [`rapier2d`].
 
+// `rapier::f64` and `rapier::f32` compile the same adapter files (one source,
+// two precisions, as Rapier builds rapier2d and rapier2d-f64).
+#![allow(clippy::duplicate_mod)]
+
+pub mod coupling;
 pub mod domino;
 pub mod impact;
 pub mod rapier;
 pub mod reference;
 pub mod theory;
+
+pub use rapier2d;
+pub use rapier2d_f64;

@@ -89,21 +89,16 @@ fn domino_group_dissipates_and_both_step_controls_agree() {
     }
 }
 
-/// A standing Domino X block on nine λ points (e2 = 0.5, friction) struck at
-/// its top by the falling block (e1 = 0.85), dumped from a Rapier scene: the
-/// impact must end well within the step limit, without creating energy, and
-/// the struck block must come away rotating forward (clockwise).
-#[test]
-fn domino_first_hit_ends_and_dissipates() {
-    let text = include_str!("data/domino-x-first-hit.json");
+/// Bodies and contacts of an impact dumped as `topple impact` input.
+fn load(text: &str) -> (Vec<topple::impact::Body>, Vec<topple::impact::Contact>) {
     let input: serde_json::Value = serde_json::from_str(text).unwrap();
-    let bodies: Vec<topple::impact::Body> = input["bodies"]
+    let bodies = input["bodies"]
         .as_array()
         .unwrap()
         .iter()
         .map(|b| serde_json::from_value(b.clone()).unwrap())
         .collect();
-    let contacts: Vec<topple::impact::Contact> = input["contacts"]
+    let contacts = input["contacts"]
         .as_array()
         .unwrap()
         .iter()
@@ -125,6 +120,16 @@ fn domino_first_hit_ends_and_dissipates() {
             )
         })
         .collect();
+    (bodies, contacts)
+}
+
+/// A standing Domino X block on nine λ points (e2 = 0.5, friction) struck at
+/// its top by the falling block (e1 = 0.85), dumped from a Rapier scene: the
+/// impact must end well within the step limit, without creating energy, and
+/// the struck block must come away rotating forward (clockwise).
+#[test]
+fn domino_first_hit_ends_and_dissipates() {
+    let (bodies, contacts) = load(include_str!("data/domino-x-first-hit.json"));
     for settings in [
         ImpactSettings {
             max_steps: 200_000,
@@ -142,6 +147,48 @@ fn domino_first_hit_ends_and_dissipates() {
         assert!(
             out.bodies[0].angular_velocity < 0.0,
             "struck block turns forward"
+        );
+    }
+}
+
+/// A wedged group from the reference engine (ideal Domino T, s/h 0.45: 15
+/// leaning blocks, e = 0 everywhere, ground friction 0.45/0.9): its e = 0
+/// contacts release and reload many times under the paper's law. The
+/// adaptive step must finish it in a few thousand steps, with the paper's
+/// law (no held contacts), and agree with the fixed step at ΔP = 10⁻⁵ P₀.
+#[test]
+fn wedged_e0_group_ends_with_the_adaptive_step() {
+    let (bodies, contacts) = load(include_str!("data/ideal-t-wedged-group.json"));
+    let fine = ImpactSolver::new()
+        .solve(&bodies, &contacts, &ImpactSettings::fixed(1e-5))
+        .unwrap();
+    let speed = bodies
+        .iter()
+        .map(|b| b.velocity[0].hypot(b.velocity[1]) + 0.04 * b.angular_velocity.abs())
+        .fold(0.0, f64::max);
+    for (tolerance, allowed) in [(1e-4, 1e-3), (1e-6, 1e-5)] {
+        let settings = ImpactSettings {
+            max_steps: 5_000,
+            ..ImpactSettings::adaptive(tolerance)
+        };
+        let out = ImpactSolver::new()
+            .solve(&bodies, &contacts, &settings)
+            .unwrap();
+        let worst = out
+            .bodies
+            .iter()
+            .zip(&fine.bodies)
+            .map(|(a, b)| {
+                (a.velocity[0] - b.velocity[0])
+                    .abs()
+                    .max((a.velocity[1] - b.velocity[1]).abs())
+                    .max(0.04 * (a.angular_velocity - b.angular_velocity).abs())
+            })
+            .fold(0.0, f64::max);
+        assert!(
+            worst < allowed * speed,
+            "tolerance {tolerance}: error {:.2e} of the speed",
+            worst / speed
         );
     }
 }

@@ -1,6 +1,6 @@
 //! What topple costs on top of Rapier (issue 5, "skips what the scene does not
 //! need"): sleeping bodies are never queried, and once its buffers have grown
-//! to the largest impact group, `resolve_impacts` allocates nothing.
+//! to the largest impact group, the impact pass allocates nothing.
 //!
 //! Allocations are counted by a global allocator that counts only while the
 //! current thread has switched counting on, so Rapier's own step (and any
@@ -15,7 +15,8 @@ use std::alloc::{GlobalAlloc, Layout, System};
 use std::cell::Cell;
 use std::sync::atomic::{AtomicUsize, Ordering};
 
-use topple::rapier::scene::{build, load_scene, Engine, SceneWorld};
+use topple::rapier::f64::{build, SceneWorld};
+use topple::rapier::scene::{load_scene, Engine};
 
 struct Counting;
 
@@ -75,19 +76,22 @@ fn growth_allocations(len: usize) -> usize {
 }
 
 /// One step as `ToppleRapier::step` does it, with topple's part counted.
-/// Returns (impacts, allocations inside `resolve_impacts`).
+/// Returns (impacts, allocations inside `begin_step` and `end_step`).
 fn counted_step(sw: &mut SceneWorld) -> (usize, usize) {
-    sw.world.step_with_events(sw.topple.hooks(), &());
     let before = ALLOCATIONS.load(Ordering::Relaxed);
+    let w = &mut sw.world;
     COUNTING.with(|c| c.set(true));
-    let impacts = sw
-        .topple
-        .resolve_impacts(
-            &mut sw.world.bodies,
-            &sw.world.colliders,
-            &sw.world.narrow_phase,
-        )
-        .expect("impact resolved");
+    sw.topple.begin_step(&w.islands, &w.bodies);
+    COUNTING.with(|c| c.set(false));
+    w.step_with_events(sw.topple.hooks(), &());
+    COUNTING.with(|c| c.set(true));
+    let impacts = sw.topple.end_step(
+        &mut w.bodies,
+        &w.colliders,
+        &w.narrow_phase,
+        &w.broad_phase,
+        &w.integration_parameters,
+    );
     COUNTING.with(|c| c.set(false));
     (impacts, ALLOCATIONS.load(Ordering::Relaxed) - before)
 }

@@ -1,6 +1,7 @@
 //! The same scene run twice gives the same bits.
 
 use topple::rapier::scene::{load_scene, run_scene, Engine, RunOptions};
+use topple::rapier::Precision;
 
 #[test]
 fn same_scene_twice_gives_identical_results() {
@@ -10,10 +11,14 @@ fn same_scene_twice_gives_identical_results() {
     scene.row.as_mut().unwrap().n = 12;
     scene.duration = 0.6;
     for engine in [Engine::Rapier, Engine::RapierNative] {
-        let a = serde_json::to_string(&run_scene(&scene, engine, RunOptions::default()).unwrap())
-            .unwrap();
-        let b = serde_json::to_string(&run_scene(&scene, engine, RunOptions::default()).unwrap())
-            .unwrap();
+        let a = serde_json::to_string(
+            &run_scene(&scene, engine, Precision::F64, RunOptions::default()).unwrap(),
+        )
+        .unwrap();
+        let b = serde_json::to_string(
+            &run_scene(&scene, engine, Precision::F64, RunOptions::default()).unwrap(),
+        )
+        .unwrap();
         assert_eq!(a, b, "{engine:?} is not deterministic");
     }
 }

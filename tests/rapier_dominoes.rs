@@ -10,6 +10,7 @@
 //! natural speed moves by about 0.1% between windows 2 and 8 on 40 blocks).
 
 use topple::rapier::scene::{run_scene, Engine, RunOptions, Scene};
+use topple::rapier::Precision;
 
 fn ideal_row(spacing: f64, n: usize, dt: f64) -> Scene {
     toml::from_str(&format!(
@@ -24,7 +25,7 @@ fn natural_speed(scene: &Scene, engine: Engine) -> f64 {
         stop_after_last_hit: true,
         ..RunOptions::default()
     };
-    let out = run_scene(scene, engine, options).unwrap();
+    let out = run_scene(scene, engine, Precision::F64, options).unwrap();
     let row = out.row.unwrap();
     row.natural_speed.unwrap_or_else(|| {
         panic!(

@@ -4,8 +4,9 @@
 //! Native Rapier's result is printed for the record.
 
 use topple::domino::{Preset, RowSpec};
-use topple::rapier::chain::run_row;
+use topple::rapier::scene::run_row;
 use topple::rapier::scene::{Engine, SolverSpec};
+use topple::rapier::Precision;
 use topple::reference::{Integrator, Settings};
 
 /// s/h 0.35 on 30 blocks and s/h 0.18 on 60 (its wave needs about 20 blocks
@@ -35,8 +36,24 @@ fn compare(spacing_ratio: f64, n: usize) {
         max_group_hops: Some(8),
         ..SolverSpec::default()
     };
-    let topple = run_row(&row, Engine::Rapier, solver.clone(), 20.0).unwrap();
-    let native = run_row(&row, Engine::RapierNative, solver, 20.0).unwrap();
+    let topple = run_row(
+        &row,
+        Engine::Rapier,
+        Precision::F64,
+        solver.clone(),
+        20.0,
+        |_| {},
+    )
+    .unwrap();
+    let native = run_row(
+        &row,
+        Engine::RapierNative,
+        Precision::F64,
+        solver,
+        20.0,
+        |_| {},
+    )
+    .unwrap();
     let got = topple.natural_speed.unwrap();
     eprintln!(
         "Domino X, Table 1, s/h {spacing_ratio}, {n} blocks: reference {expected:.4}, topple {got:.4} ({:+.1}%), native Rapier {:?}",

@@ -9,9 +9,13 @@
 //! | `reference:paper` | reference engine, the paper's improved Euler at 10⁻⁴ s |
 //! | `reference:paper:DT` | the same at time step DT (s) |
 //! | `reference:TOL` | reference engine, adaptive Dormand–Prince at tolerance TOL |
+//! | `rapier:DT` | Rapier with topple at its default settings, time step DT (s) |
 //! | `rapier:DT:STEP` | Rapier with topple, time step DT (s), fixed impulse step ΔP/P₀ = STEP |
 //! | `rapier:DT:tol:TOL` | Rapier with topple, adaptive impulse stepping at TOL |
 //! | `native:DT` | Rapier's own impact response, time step DT (s) |
+//!
+//! A Rapier run (`rapier…`, `native…`) may end in `:f32` or `:f64` to choose
+//! the Rapier build; otherwise `--precision` chooses it (default f64).
 //!
 //! Every finished run's report is written to `--out DIR` as JSON; a later call
 //! with the same DIR, row and `--freeze-tolerance` reuses the saved reports instead of
@@ -32,6 +36,7 @@ use anyhow::{bail, Context};
 use super::chain::{row_spec, RowArgs};
 use topple::domino::{ChainReport, RowSpec};
 use topple::rapier::scene::{Engine, SolverSpec};
+use topple::rapier::Precision;
 use topple::reference::{Integrator, Settings};
 
 /// Arguments of `topple bench`.
@@ -52,7 +57,7 @@ pub struct Args {
     #[arg(long)]
     pub out: Option<PathBuf>,
     /// Rapier engines: impact window (closed contacts from the struck pair).
-    #[arg(long, default_value_t = 8)]
+    #[arg(long, default_value_t = topple::coupling::ToppleSettings::DEFAULT_WINDOW)]
     pub window: usize,
     /// Reference runs: freeze blocks behind the wave below this speed
     /// (fraction of √(gh)) and acceleration (fraction of g); default 10⁻⁴.
@@ -63,6 +68,9 @@ pub struct Args {
     /// Rapier engines: stop after this much simulated time (s).
     #[arg(long, default_value_t = 600.0)]
     pub max_time: f64,
+    /// Rapier build of the Rapier runs that do not end in `:f32` or `:f64`.
+    #[arg(long, value_enum, default_value_t = Precision::F64)]
+    pub precision: Precision,
 }
 
 /// One parsed run.
@@ -71,11 +79,13 @@ enum RunKind {
     Reference(Integrator),
     Rapier {
         dt: f64,
-        impulse_step: f64,
+        impulse_step: Option<f64>,
         tolerance: Option<f64>,
+        precision: Precision,
     },
     Native {
         dt: f64,
+        precision: Precision,
     },
 }
 
@@ -89,8 +99,19 @@ fn number(text: &str, what: &str, run: &str) -> anyhow::Result<f64> {
     Ok(v)
 }
 
-fn parse_run(run: &str) -> anyhow::Result<RunKind> {
-    let parts: Vec<&str> = run.split(':').collect();
+/// Parses one run; `default` is the Rapier build of a Rapier run that does
+/// not name one.
+fn parse_run(run: &str, default: Precision) -> anyhow::Result<RunKind> {
+    let mut parts: Vec<&str> = run.split(':').collect();
+    let named = match parts.last() {
+        Some(&"f32") if parts.len() > 2 => Some(Precision::F32),
+        Some(&"f64") if parts.len() > 2 => Some(Precision::F64),
+        _ => None,
+    };
+    if named.is_some() {
+        parts.pop();
+    }
+    let precision = named.unwrap_or(default);
     Ok(match parts.as_slice() {
         ["reference", "paper"] => RunKind::Reference(Integrator::Paper { dt: 1e-4 }),
         ["reference", "paper", dt] => RunKind::Reference(Integrator::Paper {
@@ -101,22 +122,45 @@ fn parse_run(run: &str) -> anyhow::Result<RunKind> {
         }),
         ["rapier", dt, "tol", tol] => RunKind::Rapier {
             dt: number(dt, "time step", run)?,
-            impulse_step: 1e-4,
+            impulse_step: None,
             tolerance: Some(number(tol, "tolerance", run)?),
+            precision,
+        },
+        ["rapier", dt] => RunKind::Rapier {
+            dt: number(dt, "time step", run)?,
+            impulse_step: None,
+            tolerance: None,
+            precision,
         },
         ["rapier", dt, step] => RunKind::Rapier {
             dt: number(dt, "time step", run)?,
-            impulse_step: number(step, "impulse step", run)?,
+            impulse_step: Some(number(step, "impulse step", run)?),
             tolerance: None,
+            precision,
         },
         ["native", dt] => RunKind::Native {
             dt: number(dt, "time step", run)?,
+            precision,
         },
         _ => bail!(
             "run {run:?} is not one of reference:paper[:DT], reference:TOL, \
-             rapier:DT:STEP, rapier:DT:tol:TOL, native:DT"
+             rapier:DT, rapier:DT:STEP, rapier:DT:tol:TOL, native:DT (Rapier runs may end in :f32 or :f64)"
         ),
     })
+}
+
+/// The run's name with its Rapier build spelled out (`native:1e-3` run with
+/// `--precision f32` is `native:1e-3:f32`): the key of its saved report, so
+/// that saved reports of the two builds never mix.
+fn full_name(run: &str, kind: &RunKind) -> String {
+    match kind {
+        RunKind::Rapier { precision, .. } | RunKind::Native { precision, .. }
+            if !(run.ends_with(":f32") || run.ends_with(":f64")) =>
+        {
+            format!("{run}:{}", precision.name())
+        }
+        _ => run.to_string(),
+    }
 }
 
 /// A saved run: the row it belongs to and the engine's report.
@@ -159,9 +203,11 @@ fn execute_with(
             dt,
             impulse_step,
             tolerance,
-        } => topple::rapier::chain::run_row_with_progress(
+            precision,
+        } => topple::rapier::scene::run_row(
             row,
             Engine::Rapier,
+            precision,
             SolverSpec {
                 dt,
                 impulse_step,
@@ -172,9 +218,10 @@ fn execute_with(
             args.max_time,
             progress,
         )?,
-        RunKind::Native { dt } => topple::rapier::chain::run_row_with_progress(
+        RunKind::Native { dt, precision } => topple::rapier::scene::run_row(
             row,
             Engine::RapierNative,
+            precision,
             SolverSpec {
                 dt,
                 max_group_hops: Some(args.window),
@@ -221,7 +268,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     let kinds: Vec<(String, RunKind)> = args
         .runs
         .iter()
-        .map(|r| parse_run(r.trim()).map(|k| (r.trim().to_string(), k)))
+        .map(|r| parse_run(r.trim(), args.precision).map(|k| (r.trim().to_string(), k)))
         .collect::<anyhow::Result<_>>()?;
     let baseline = match &args.baseline {
         Some(b) => Some(
@@ -237,7 +284,8 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     }
     let mut reports: Vec<ChainReport> = Vec::with_capacity(kinds.len());
     for (k, (name, kind)) in kinds.iter().enumerate() {
-        let path = args.out.as_ref().map(|d| d.join(file_name(name)));
+        let key = full_name(name, kind);
+        let path = args.out.as_ref().map(|d| d.join(file_name(&key)));
         // the freeze tolerance matters to reference runs only
         let freeze = match kind {
             RunKind::Reference(_) => args.freeze_tolerance,
@@ -252,7 +300,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
                 serde_json::from_str(&text).with_context(|| format!("parsing {}", p.display()))
             })
             .transpose()?
-            .filter(|s| s.row == row && s.run == *name && s.freeze_tolerance == freeze);
+            .filter(|s| s.row == row && s.run == key && s.freeze_tolerance == freeze);
         let report = match saved {
             Some(s) => {
                 eprintln!("[{}/{}] {name}: saved report reused", k + 1, kinds.len());
@@ -273,7 +321,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
                 );
                 if let Some(p) = &path {
                     let saved = Saved {
-                        run: name.clone(),
+                        run: key.clone(),
                         row,
                         freeze_tolerance: freeze,
                         report: report.clone(),
@@ -306,7 +354,7 @@ fn front_speed(r: &ChainReport, row: &RowSpec) -> Option<f64> {
 /// Rapier time step of a run, if it is a Rapier run.
 fn rapier_dt(kind: &RunKind) -> Option<f64> {
     match *kind {
-        RunKind::Rapier { dt, .. } | RunKind::Native { dt } => Some(dt),
+        RunKind::Rapier { dt, .. } | RunKind::Native { dt, .. } => Some(dt),
         RunKind::Reference(_) => None,
     }
 }
@@ -345,11 +393,15 @@ fn print_table(
             let steps = (r.simulated_time / dt).round().max(1.0);
             1e3 * r.run_time / steps
         });
+        let precision = match *kind {
+            RunKind::Rapier { precision, .. } | RunKind::Native { precision, .. } => precision,
+            RunKind::Reference(_) => Precision::F64,
+        };
         let native_ms = rapier_dt(kind).and_then(|dt| {
             kinds
                 .iter()
                 .zip(reports)
-                .find(|((_, k2), _)| *k2 == RunKind::Native { dt })
+                .find(|((_, k2), _)| *k2 == RunKind::Native { dt, precision })
                 .map(|(_, r2)| 1e3 * r2.run_time / (r2.simulated_time / dt).round().max(1.0))
         });
         let ratio = match (kind, ms_per_step, native_ms) {
@@ -392,27 +444,53 @@ mod tests {
     #[test]
     fn runs_parse_and_bad_ones_are_refused() {
         assert_eq!(
-            parse_run("reference:paper").unwrap(),
+            parse_run("reference:paper", Precision::F64).unwrap(),
             RunKind::Reference(Integrator::Paper { dt: 1e-4 })
         );
         assert_eq!(
-            parse_run("reference:1e-8").unwrap(),
+            parse_run("reference:1e-8", Precision::F64).unwrap(),
             RunKind::Reference(Integrator::Adaptive { tolerance: 1e-8 })
         );
         assert_eq!(
-            parse_run("rapier:1e-3:1e-4").unwrap(),
+            parse_run("rapier:1e-3:1e-4", Precision::F64).unwrap(),
             RunKind::Rapier {
                 dt: 1e-3,
-                impulse_step: 1e-4,
-                tolerance: None
+                impulse_step: Some(1e-4),
+                tolerance: None,
+                precision: Precision::F64,
             }
         );
         assert_eq!(
-            parse_run("native:5e-4").unwrap(),
-            RunKind::Native { dt: 5e-4 }
+            parse_run("native:5e-4", Precision::F32).unwrap(),
+            RunKind::Native {
+                dt: 5e-4,
+                precision: Precision::F32
+            }
         );
-        for bad in ["rapier:1e-3", "native:-1", "reference:abc", "bullet:1e-3"] {
-            assert!(parse_run(bad).is_err(), "{bad}");
+        assert_eq!(
+            parse_run("native:5e-4:f64", Precision::F32).unwrap(),
+            RunKind::Native {
+                dt: 5e-4,
+                precision: Precision::F64
+            }
+        );
+        assert_eq!(
+            parse_run("rapier:1e-3", Precision::F64).unwrap(),
+            RunKind::Rapier {
+                dt: 1e-3,
+                impulse_step: None,
+                tolerance: None,
+                precision: Precision::F64,
+            }
+        );
+        for bad in [
+            "rapier:0",
+            "native:-1",
+            "reference:abc",
+            "bullet:1e-3",
+            "native:f32",
+        ] {
+            assert!(parse_run(bad, Precision::F64).is_err(), "{bad}");
         }
     }
 
@@ -425,7 +503,7 @@ mod tests {
             "reference:1e-9",
         ]
         .iter()
-        .map(|r| (r.to_string(), parse_run(r).unwrap()))
+        .map(|r| (r.to_string(), parse_run(r, Precision::F64).unwrap()))
         .collect();
         assert_eq!(default_baseline(&kinds), Some(3));
         assert_eq!(default_baseline(&kinds[..2]), Some(1));

@@ -123,7 +123,7 @@ pub struct Args {
     pub dt: f64,
     /// Rapier engines: impact window, the number of closed contacts from the
     /// struck pair beyond which bodies are left out of an impact.
-    #[arg(long, default_value_t = 8)]
+    #[arg(long, default_value_t = topple::coupling::ToppleSettings::DEFAULT_WINDOW)]
     pub window: usize,
     /// Rapier engines: stop after this much simulated time (s) if the last
     /// block has not been hit.
@@ -138,6 +138,9 @@ pub struct Args {
     /// twice the run time, see README).
     #[arg(long)]
     pub heel_contacts: bool,
+    /// Rapier engines: the Rapier build (f32 is what bevy_rapier2d uses).
+    #[arg(long, value_enum, default_value_t = topple::rapier::Precision::F64)]
+    pub precision: topple::rapier::Precision,
     /// Print the report as JSON.
     #[arg(long)]
     pub json: bool,
@@ -272,9 +275,10 @@ pub fn run(args: Args) -> anyhow::Result<()> {
             ..Default::default()
         };
         let bar = super::blocks_bar(row.n, engine.name());
-        let report = topple::rapier::chain::run_row_with_progress(
+        let report = topple::rapier::scene::run_row(
             &row,
             engine,
+            args.precision,
             solver,
             args.max_time,
             |hit| bar.set_position(hit as u64),

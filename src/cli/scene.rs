@@ -3,6 +3,7 @@
 use std::path::PathBuf;
 
 use topple::rapier::scene::{load_scene, run_scene, Engine, RunOptions};
+use topple::rapier::Precision;
 
 /// Arguments of `topple scene`.
 #[derive(clap::Args)]
@@ -18,9 +19,13 @@ pub struct Args {
     /// Stop a domino-row scene once its last block has been hit.
     #[arg(long)]
     pub until_last_hit: bool,
-    /// If an impact cannot be resolved, write it here (input of `topple impact`).
+    /// Rapier build (f32 is what bevy_rapier2d uses).
+    #[arg(long, value_enum, default_value_t = Precision::F64)]
+    pub precision: Precision,
+    /// Write the first impact that needed the fallback policy (held e = 0
+    /// contacts or a plastic impact) here, as input for `topple impact`.
     #[arg(long)]
-    pub dump_failed_impact: Option<PathBuf>,
+    pub dump_fallback_impact: Option<PathBuf>,
 }
 
 /// Runs the scene and prints final body states and the impacts resolved.
@@ -28,16 +33,17 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     let scene = load_scene(&args.file)?;
     let options = RunOptions {
         stop_after_last_hit: args.until_last_hit,
-        dump_failed_impact: args.dump_failed_impact.clone(),
+        dump_fallback_impact: args.dump_fallback_impact.clone(),
     };
-    let out = run_scene(&scene, args.engine, options)?;
+    let out = run_scene(&scene, args.engine, args.precision, options)?;
     if args.json {
         println!("{}", serde_json::to_string_pretty(&out)?);
         return Ok(());
     }
     println!(
-        "engine {}  t = {:.6} s  steps {}  kinetic energy {:.6e} -> {:.6e} J",
+        "engine {} ({})  t = {:.6} s  steps {}  kinetic energy {:.6e} -> {:.6e} J",
         out.engine.name(),
+        out.precision.name(),
         out.time,
         out.steps,
         out.kinetic_energy[0],

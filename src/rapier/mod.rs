@@ -1,33 +1,161 @@
-//! The plugin for rapier2d-f64: LZB impacts and λ-point contact inside a
-//! Rapier world.
+//! The plugin for Rapier: LZB impacts and λ-point contact inside a Rapier
+//! world. One adapter source, compiled for `rapier2d-f64` ([`f64`]) and for
+//! `rapier2d` ([`f32`], what `bevy_rapier2d` uses), as Rapier builds its two
+//! crates from one source.
 //!
-//! | item | role | engine |
+//! | item | role | precision |
 //! | --- | --- | --- |
-//! | [`MaterialTable`], [`PairMaterial`] | impact law per collider, pair overrides | agnostic |
-//! | [`for_each_contact_point`], [`PatchRule`] | λ points across flat contact patches | agnostic |
-//! | [`ImpactGroups`], [`PointContact`], [`ToppleSettings`] | impact events, their groups, the resolver call | agnostic |
-//! | [`ToppleRapier`], [`ToppleHooks`] | thin adapter and physics hook for rapier2d-f64 | Rapier |
-//! | [`scene`] | TOML scenes (boxes, balls, domino rows) run with or without topple | Rapier |
+//! | [`f64::ToppleRapier`], [`f32::ToppleRapier`] | the adapter: Rapier step, impact pass, velocities back | per build |
+//! | [`f64::ToppleHooks`], [`f32::ToppleHooks`] | physics hook: per-pair friction, Rapier's restitution off on managed pairs | per build |
+//! | [`HookMode`], [`ToppleStats`], [`Precision`] | who resolves impacts, running totals, which build | agnostic |
+//! | [`scene`] | TOML scenes (boxes, balls, domino rows) run with or without topple, in either precision | agnostic front, per-build worlds |
 //!
-//! After each Rapier step the narrow phase describes the start of that step;
-//! topple queries parry2d-f64 on Rapier's candidate pairs for the contacts at
-//! the current positions, turns flat patches into λ points, finds closed
-//! contacts that approach, groups the bodies connected through closed
-//! contacts, and resolves each group with [`crate::impact::ImpactSolver`].
-//! On managed pairs the hook switches Rapier's restitution off and drops its
-//! speculative (still open) contact points, which would otherwise stop an
-//! approaching pair inelastically at the instant of touching.
+//! Materials, λ-point patches, impact groups and the fallback policy live in
+//! [`crate::coupling`]; the adapter only reads Rapier's state into plain f64
+//! data and writes velocities back.
+//!
+//! # Impacts at their instant
+//!
+//! A game steps Rapier at 1/60 s, and a falling domino's corner moves 2.5 cm
+//! in such a step across a 3.6 cm gap; an impact found at the end of the
+//! step would be resolved late and deep, at positions the bodies never had
+//! together. The adapter resolves each impact at the instant its pair closes
+//! and splits Rapier's step there:
+//!
+//! 1. before the step it records the awake poses and predicts the first
+//!    closing of the pairs the fast bodies may reach (a swept box against
+//!    Rapier's broad phase, the gap along straight paths at the present
+//!    velocities);
+//! 2. Rapier steps to that instant with topple's hook, which takes from
+//!    Rapier's solver the contact points approaching faster than the impact
+//!    threshold (unless they belong to a lasting contact) and notes their
+//!    pairs;
+//! 3. the pass after the step finds each candidate's first closing time τ on
+//!    the straight paths between the two poses of the step, builds the group
+//!    at the poses of τ, resolves it through [`crate::coupling`], moves the
+//!    changed bodies on from τ with their new velocities, repeats, and writes
+//!    velocities and poses back;
+//! 4. Rapier steps on to the next predicted instant or the end of the step
+//!    (at most [`crate::coupling::ToppleSettings::max_splits`] splits).
+//!
+//! The alternative, sub-stepping only the bodies of an impact while Rapier
+//! steps the rest, would need a second contact solver for those bodies;
+//! splitting keeps Rapier's smooth phase for everything and costs one more
+//! Rapier step per impact. Why splitting matters as much as the instant:
+//! after the impact the smooth forces (the blocks leaning on the struck one)
+//! act on the post-impact velocities from τ on (ideal Domino T row, s/h 0.45,
+//! 1/60 s, reference engine 1.78: at the end of the step v̂_na 1.03, at the
+//! instant 1.55, at the instant with splitting 1.71; see
+//! `docs/game-rate.md`). ARCHITECTURE.md walks through the whole path.
 
-pub mod chain;
-mod group;
-mod hooks;
-mod material;
-mod patch;
+pub mod f32;
+pub mod f64;
 pub mod scene;
-mod world;
 
-pub use group::{normal_velocity, ImpactGroups, ImpactReport, PointContact, ToppleSettings};
-pub use hooks::{HookMode, ToppleHooks};
-pub use material::{MaterialId, MaterialTable, PairMaterial};
-pub use patch::{for_each_contact_point, ManifoldPoint, PatchRule};
-pub use world::{ToppleRapier, ToppleStats};
+use serde::{Deserialize, Serialize};
+
+use crate::coupling::{ImpactReport, Resolution};
+
+/// Natural frequency (Hz) of Rapier's soft contacts that domino rows use
+/// (Rapier's default is 30 Hz; fixed pairs get twice the value). topple's
+/// model keeps contacts rigid between impacts; at Rapier's default a row of
+/// leaning blocks at a game step is spongy: the blocks leaning on the struck
+/// one push it too weakly and re-touch it in many small impacts (ideal
+/// Domino T, s/h 0.45, 100 blocks, measured in `docs/game-rate.md`: topple
+/// at 1/60 s 1.53 against 1.64 at 480 Hz, reference 1.78; native Rapier 1.32
+/// and 1.46). Both engines of a row comparison use the same value.
+pub const ROW_CONTACT_HERTZ: f64 = 480.0;
+
+/// Who resolves impacts on managed pairs.
+///
+/// ```
+/// use topple::coupling::ToppleSettings;
+/// use topple::rapier::{f64::ToppleRapier, HookMode};
+/// assert_eq!(ToppleRapier::new(ToppleSettings::default()).hooks().mode(), HookMode::Topple);
+/// assert_eq!(ToppleRapier::native().hooks().mode(), HookMode::Native);
+/// ```
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum HookMode {
+    /// topple resolves impacts; Rapier keeps resting contact with restitution 0
+    /// and without the contact points that are still open (speculative) or
+    /// approach faster than topple's impact threshold: Rapier would stop those
+    /// inelastically at the moment of touching, before topple sees them.
+    Topple,
+    /// Rapier resolves impacts itself with the pair's restitution; the hook
+    /// only sets friction and restitution per pair (native Rapier response).
+    Native,
+}
+
+/// Which Rapier build runs a world.
+///
+/// ```
+/// use topple::rapier::Precision;
+/// assert_eq!(Precision::default(), Precision::F64);
+/// assert_eq!(Precision::F32.name(), "f32");
+/// ```
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize, clap::ValueEnum)]
+#[serde(rename_all = "lowercase")]
+pub enum Precision {
+    /// `rapier2d` (f32), the build `bevy_rapier2d` uses.
+    F32,
+    /// `rapier2d-f64`.
+    #[default]
+    F64,
+}
+
+impl Precision {
+    /// The name used on the command line and in JSON.
+    pub fn name(self) -> &'static str {
+        match self {
+            Precision::F32 => "f32",
+            Precision::F64 => "f64",
+        }
+    }
+}
+
+/// Running totals of an adapter over all its impact passes.
+///
+/// ```
+/// use topple::coupling::ToppleSettings;
+/// use topple::rapier::f64::ToppleRapier;
+/// assert_eq!(ToppleRapier::new(ToppleSettings::default()).stats().impacts, 0);
+/// ```
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
+pub struct ToppleStats {
+    /// Candidate pairs queried at the current positions.
+    pub pairs_queried: u64,
+    /// Closed contact points found (λ points counted one by one).
+    pub contact_points: u64,
+    /// Impacts resolved (every resolution below).
+    pub impacts: u64,
+    /// Resolver impulse steps, summed (plastic sweeps included).
+    pub impulse_steps: u64,
+    /// Impacts solved again with their e = 0 contacts held closed.
+    pub held_impacts: u64,
+    /// Impacts resolved as plastic (the last stage of the fallback policy).
+    pub plastic_fallbacks: u64,
+    /// Impact groups with invalid data (non-finite state), left unresolved.
+    pub rejected_impacts: u64,
+    /// Rapier steps split at a predicted impact instant.
+    pub split_steps: u64,
+    /// Wall time spent in topple's own work, Rapier's step excluded (s).
+    /// Not serialized: outputs stay the same bits from run to run.
+    #[serde(skip)]
+    pub topple_seconds: f64,
+}
+
+impl ToppleStats {
+    /// Adds the impacts of one pass.
+    pub fn record(&mut self, reports: &[ImpactReport]) {
+        for r in reports {
+            self.impacts += 1;
+            self.impulse_steps += r.steps as u64;
+            match r.resolution {
+                Resolution::Lzb => {}
+                Resolution::Held => self.held_impacts += 1,
+                Resolution::Plastic => self.plastic_fallbacks += 1,
+                Resolution::Rejected => self.rejected_impacts += 1,
+            }
+        }
+    }
+}

@@ -61,16 +61,24 @@ fn default_gravity() -> [f64; 2] {
 pub struct SolverSpec {
     /// Rapier time step (s).
     pub dt: f64,
-    /// Rapier's length unit (m): scales its slop, prediction distance and
-    /// corrective velocities; set it to a typical body size.
-    pub length_unit: f64,
+    /// Rapier's length unit (m): scales its allowed penetration (0.005 of
+    /// it), prediction distance (0.02 of it) and corrective velocities; set it
+    /// to a typical body size. Default: a row's block height for a scene with
+    /// a row, else 1 m (Rapier's default).
+    pub length_unit: Option<f64>,
+    /// Natural frequency (Hz) of Rapier's soft contacts between dynamic
+    /// bodies (twice that against fixed bodies). Default: Rapier's 30 Hz,
+    /// and [`crate::rapier::ROW_CONTACT_HERTZ`] for a scene with a row.
+    pub contact_hertz: Option<f64>,
     /// Rapier solver iterations per step.
     pub iterations: usize,
     /// Rapier's contact recycling (pairs with hooks are never recycled).
     pub contact_recycling: bool,
-    /// Fixed impulse step ΔP/P₀ of the LZB resolver (the paper: 10⁻⁴).
-    pub impulse_step: f64,
-    /// Adaptive impulse stepping with this tolerance instead (if set).
+    /// The paper's fixed impulse step ΔP/P₀ of the LZB resolver (10⁻⁴ in
+    /// the paper), if set and `tolerance` is not.
+    pub impulse_step: Option<f64>,
+    /// Adaptive impulse stepping at this relative tolerance; the default when
+    /// neither is set is 10⁻⁶.
     pub tolerance: Option<f64>,
     /// λ points across a flat contact patch.
     pub lambda: usize,
@@ -78,8 +86,12 @@ pub struct SolverSpec {
     /// impact; default max(10⁻³, 2|g|Δt).
     pub min_approach_speed: Option<f64>,
     /// Impact window: bodies more than this many closed contacts away from
-    /// the impact and their contacts are left out (none: the whole group).
+    /// the impact and their contacts are left out (default
+    /// [`crate::coupling::ToppleSettings::DEFAULT_WINDOW`]).
     pub max_group_hops: Option<usize>,
+    /// Rapier steps split at predicted impact instants, at most, per step
+    /// (default 4; 0 never splits).
+    pub max_splits: Option<usize>,
     /// Gap (m) at or below which a contact point is closed.
     pub closed_tolerance: f64,
 }
@@ -88,10 +100,12 @@ impl Default for SolverSpec {
     fn default() -> Self {
         SolverSpec {
             dt: 1e-3,
-            length_unit: 1.0,
+            length_unit: None,
+            contact_hertz: None,
+            max_splits: None,
             iterations: 4,
             contact_recycling: true,
-            impulse_step: 1e-4,
+            impulse_step: None,
             tolerance: None,
             lambda: 9,
             min_approach_speed: None,

@@ -1,19 +1,25 @@
 //! Scenes: a documented TOML format (boxes, balls, ground, materials, pair
 //! rules, gravity, duration, solver settings, a domino-row generator), built
-//! into a Rapier world and run with topple or with native Rapier.
+//! into a Rapier world and run with topple or with native Rapier, on either
+//! Rapier build.
+//!
+//! | item | file | role |
+//! | --- | --- | --- |
+//! | [`Scene`] and its parts | `format.rs` | the TOML format (serde) |
+//! | [`expand_row`], [`preset`], [`RowMeasures`] | `row.rs` | the domino-row generator and its wave measures |
+//! | [`Engine`], [`run_scene`], [`run_row`], [`SceneOutput`] | `setup.rs` | build-independent front: settings, materials, output, dispatch to [`crate::rapier::f64`] or [`crate::rapier::f32`] |
 
-mod build;
 mod format;
 mod row;
-mod run;
+mod setup;
 
-pub use build::{build, topple_settings, Engine, RowInfo, SceneWorld};
 pub use format::{
     BodySpec, GroundSpec, MaterialSpec, PairLaw, PairSpec, RowOverrides, RowSpec, Scene, ShapeKind,
     SolverSpec,
 };
 pub use row::{expand_row, preset, Preset, RowMeasures};
-pub use run::{
-    impact_input_json, load_scene, run_scene, signed_gap, BodyState, HitTracker, RunOptions,
+pub(crate) use setup::pair_material;
+pub use setup::{
+    load_scene, row_scene, run_row, run_scene, topple_settings, BodyState, Engine, RunOptions,
     SceneOutput, TimedImpact,
 };

@@ -10,7 +10,7 @@
 /// One point of a contact manifold at the current positions (world frame, m).
 ///
 /// ```
-/// use topple::rapier::ManifoldPoint;
+/// use topple::coupling::ManifoldPoint;
 /// let p = ManifoldPoint { point: [0.0, 0.0], dist: -1e-6 }; // penetrating by 1 µm
 /// assert!(p.dist < 0.0);
 /// ```
@@ -25,7 +25,7 @@ pub struct ManifoldPoint {
 /// How a manifold becomes resolver contact points.
 ///
 /// ```
-/// use topple::rapier::PatchRule;
+/// use topple::coupling::PatchRule;
 /// let paper = PatchRule { lambda: 9, ..PatchRule::default() };
 /// assert!(paper.closed_tolerance >= 0.0);
 /// ```
@@ -37,6 +37,9 @@ pub struct PatchRule {
     pub lambda: usize,
     /// Two closed points closer than this (m) are one point, not a patch.
     pub min_patch_length: f64,
+    /// Two closed points are a flat patch only if their gaps differ by at
+    /// most this (m); a face tilted further touches with one corner.
+    pub flat_tolerance: f64,
 }
 
 impl Default for PatchRule {
@@ -45,18 +48,19 @@ impl Default for PatchRule {
             closed_tolerance: 1e-9,
             lambda: 9,
             min_patch_length: 1e-9,
+            flat_tolerance: 1e-6,
         }
     }
 }
 
 /// Calls `emit(point, gap)` for each closed contact point of a manifold of up
 /// to two points sharing one normal: λ points spread from the first to the
-/// second point, gaps interpolated linearly, when both are closed and apart
-/// (a flat face on a flat face); else every closed point on its own (a corner,
-/// a ball). Open points (gap > tolerance) take no part.
+/// second point, gaps interpolated linearly, when both are closed, apart and
+/// level (a flat face on a flat face); else every closed point on its own (a
+/// corner, a ball). Open points (gap > tolerance) take no part.
 ///
 /// ```
-/// use topple::rapier::{for_each_contact_point, ManifoldPoint, PatchRule};
+/// use topple::coupling::{for_each_contact_point, ManifoldPoint, PatchRule};
 /// // the bottom face of a block 0.01 m thick resting on the ground
 /// let face = [
 ///     ManifoldPoint { point: [-0.005, 0.0], dist: -1e-6 },
@@ -81,7 +85,8 @@ pub fn for_each_contact_point(
     let closed = |p: &ManifoldPoint| p.dist <= rule.closed_tolerance;
     if let [a, b] = points {
         let len = (b.point[0] - a.point[0]).hypot(b.point[1] - a.point[1]);
-        if closed(a) && closed(b) && len > rule.min_patch_length && rule.lambda >= 2 {
+        let level = (a.dist - b.dist).abs() <= rule.flat_tolerance;
+        if closed(a) && closed(b) && level && len > rule.min_patch_length && rule.lambda >= 2 {
             let last = (rule.lambda - 1) as f64;
             for p in 0..rule.lambda {
                 let s = p as f64 / last;

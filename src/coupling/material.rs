@@ -19,7 +19,7 @@ pub struct MaterialId(pub u16);
 ///
 /// ```
 /// use topple::impact::ContactMaterial;
-/// use topple::rapier::PairMaterial;
+/// use topple::coupling::PairMaterial;
 /// let m = PairMaterial::from_table(ContactMaterial::hertz(2.3e8), 0.17, 0.20, 0.85, 0.5);
 /// assert_eq!(m.impact.friction, 0.085);
 /// assert_eq!(m.smooth_friction, 0.17);
@@ -79,7 +79,7 @@ impl PairMaterial {
 ///
 /// ```
 /// use topple::impact::ContactMaterial;
-/// use topple::rapier::{MaterialTable, PairMaterial};
+/// use topple::coupling::{MaterialTable, PairMaterial};
 /// let mut table = MaterialTable::default();
 /// let block = table.add(PairMaterial { impact: ContactMaterial::hertz(2.3e8), smooth_friction: 0.0 });
 /// let ground = table.add(PairMaterial { impact: ContactMaterial::hertz(6.9e8), smooth_friction: 0.9 });

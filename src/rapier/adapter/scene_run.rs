@@ -1,69 +1,13 @@
 //! Running a scene to its end and collecting what the command prints.
 
-use rapier2d_f64::parry::query;
-use rapier2d_f64::prelude::{ColliderHandle, ColliderSet};
+use super::backend::parry::query;
+use super::backend::prelude::{ColliderHandle, ColliderSet, RigidBodySet};
 
-use crate::rapier::{ImpactReport, ToppleStats};
-
-use super::build::{build, Engine, SceneWorld};
-use super::format::Scene;
-use super::row::RowMeasures;
-
-/// A body's state at the end.
-#[derive(Clone, Debug, PartialEq, serde::Serialize)]
-pub struct BodyState {
-    /// Name.
-    pub name: String,
-    /// Centre of mass (m).
-    pub position: [f64; 2],
-    /// Angle (rad).
-    pub angle: f64,
-    /// Velocity (m/s).
-    pub velocity: [f64; 2],
-    /// Angular velocity (rad/s).
-    pub angular_velocity: f64,
-}
-
-/// An impact with the time it was resolved.
-#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
-pub struct TimedImpact {
-    /// Time (s).
-    pub time: f64,
-    /// What it did.
-    #[serde(flatten)]
-    pub report: ImpactReport,
-}
-
-/// What a scene run returns.
-#[derive(Clone, Debug, serde::Serialize)]
-pub struct SceneOutput {
-    /// Engine used.
-    pub engine: Engine,
-    /// Simulated time (s).
-    pub time: f64,
-    /// Steps taken.
-    pub steps: usize,
-    /// Final body states.
-    pub bodies: Vec<BodyState>,
-    /// Kinetic energy at the start and at the end (J per unit depth).
-    pub kinetic_energy: [f64; 2],
-    /// Impacts resolved by topple (none for the native engine).
-    pub impacts: Vec<TimedImpact>,
-    /// topple's counters.
-    pub stats: ToppleStats,
-    /// Wave measures, for a scene with a row.
-    pub row: Option<RowMeasures>,
-}
-
-/// Options of [`run_scene`].
-#[derive(Clone, Debug, Default)]
-pub struct RunOptions {
-    /// Stop a row scene once its last block has been hit.
-    pub stop_after_last_hit: bool,
-    /// If the resolver fails, write the failing group here as input for
-    /// `topple impact`.
-    pub dump_failed_impact: Option<std::path::PathBuf>,
-}
+use super::scene_build::{build, SceneWorld};
+use crate::coupling::Resolution;
+use crate::rapier::scene::{
+    BodyState, Engine, RowMeasures, RunOptions, Scene, SceneOutput, TimedImpact,
+};
 
 /// The group solved last by topple in the `topple impact` input format.
 pub fn impact_input_json(sw: &SceneWorld) -> serde_json::Value {
@@ -90,17 +34,36 @@ pub fn impact_input_json(sw: &SceneWorld) -> serde_json::Value {
     })
 }
 
-/// Signed gap between two colliders (m): negative when penetrating.
-pub fn signed_gap(colliders: &ColliderSet, a: ColliderHandle, b: ColliderHandle) -> f64 {
+/// Signed gap between two colliders (m): negative when penetrating. The
+/// colliders are placed by their parent bodies' poses, which are current even
+/// between a write into the bodies and Rapier's next step.
+pub fn signed_gap(
+    bodies: &RigidBodySet,
+    colliders: &ColliderSet,
+    a: ColliderHandle,
+    b: ColliderHandle,
+) -> f64 {
+    let pose = |c: ColliderHandle| {
+        let co = &colliders[c];
+        match (
+            co.parent().and_then(|h| bodies.get(h)),
+            co.position_wrt_parent(),
+        ) {
+            (Some(rb), Some(offset)) => *rb.position() * *offset,
+            _ => *co.position(),
+        }
+    };
     let (ca, cb) = (&colliders[a], &colliders[b]);
-    match query::contact(ca.position(), ca.shape(), cb.position(), cb.shape(), 0.0) {
-        Ok(Some(c)) => c.dist,
-        _ => query::distance(ca.position(), ca.shape(), cb.position(), cb.shape())
-            .unwrap_or(f64::INFINITY),
+    let (pa, pb) = (pose(a), pose(b));
+    match query::contact(&pa, ca.shape(), &pb, cb.shape(), 0.0) {
+        Ok(Some(c)) => f64::from(c.dist),
+        _ => query::distance(&pa, ca.shape(), &pb, cb.shape()).map_or(f64::INFINITY, f64::from),
     }
 }
 
-/// Tracks when block k hits block k + 1 along a row.
+/// Tracks when block k hits block k + 1 along a row: at the instant of
+/// topple's impact between them when there is one, else where the gap between
+/// them, taken as linear in time over the step, falls to `HIT_GAP`.
 #[derive(Clone, Debug, Default)]
 pub struct HitTracker {
     /// T_i (s), T_1 = 0.
@@ -121,7 +84,7 @@ impl HitTracker {
         }
     }
 
-    /// Checks the front pair after a step ending at `time` of length `dt`.
+    /// Checks the front pair after a step ending at `time` of length `dt` (s).
     pub fn update(&mut self, sw: &SceneWorld, time: f64, dt: f64) {
         let Some(row) = &sw.row else { return };
         loop {
@@ -129,14 +92,24 @@ impl HitTracker {
             if k >= row.colliders.len() {
                 return;
             }
-            let gap = signed_gap(&sw.world.colliders, row.colliders[k - 1], row.colliders[k]);
-            if gap > HIT_GAP {
+            let w = &sw.world;
+            let gap = signed_gap(
+                &w.bodies,
+                &w.colliders,
+                row.colliders[k - 1],
+                row.colliders[k],
+            );
+            let struck = first_impact(sw, row.colliders[k - 1], row.colliders[k]);
+            if gap > HIT_GAP && struck.is_none() {
                 self.prev_gap = Some(gap);
                 return;
             }
-            let t = match self.prev_gap {
-                Some(g0) if g0 > gap => time - dt + dt * (g0 - HIT_GAP) / (g0 - gap),
-                _ => time,
+            // topple knows the instant of the impact; otherwise the gap is
+            // taken as linear in time over the step
+            let t = match (struck, self.prev_gap) {
+                (Some(in_step), _) => time - dt + in_step,
+                (None, Some(g0)) if g0 > gap => time - dt + dt * (g0 - HIT_GAP) / (g0 - gap),
+                (None, _) => time,
             };
             self.hit_times.push(t);
             self.prev_gap = None;
@@ -144,10 +117,30 @@ impl HitTracker {
     }
 }
 
-/// Runs a scene with an engine.
+/// The instant (s into the last step) of the first impact of the last step
+/// with a contact between the bodies of colliders `a` and `b`.
+fn first_impact(sw: &SceneWorld, a: ColliderHandle, b: ColliderHandle) -> Option<f64> {
+    let body = |c: ColliderHandle| sw.world.colliders.get(c).and_then(|co| co.parent());
+    let (ba, bb) = (body(a)?, body(b)?);
+    sw.topple
+        .last_events()
+        .iter()
+        .filter(|ev| {
+            sw.topple
+                .event_contacts(ev)
+                .iter()
+                .any(|c| c.bodies == [Some(ba), Some(bb)] || c.bodies == [Some(bb), Some(ba)])
+        })
+        .map(|ev| ev.time_in_step)
+        .min_by(f64::total_cmp)
+}
+
+/// Runs a scene with an engine on this Rapier build (see
+/// [`crate::rapier::scene::run_scene`] for either build).
 ///
 /// ```
-/// use topple::rapier::scene::{run_scene, Engine, RunOptions, Scene};
+/// use topple::rapier::f64::run_scene;
+/// use topple::rapier::scene::{Engine, RunOptions, Scene};
 /// let scene: Scene = toml::from_str(r#"
 ///     duration = 0.01
 ///     gravity = [0.0, 0.0]
@@ -178,25 +171,24 @@ pub fn run_scene(
     options: RunOptions,
 ) -> anyhow::Result<SceneOutput> {
     let mut sw = build(scene, engine)?;
-    let dt = sw.world.integration_parameters.dt;
+    let dt = f64::from(sw.world.integration_parameters.dt);
     let steps = (scene.duration / dt).round() as usize;
     let ke0 = sw.kinetic_energy();
     let mut impacts = Vec::new();
     let mut hits = HitTracker::new();
     let mut taken = 0;
+    let mut dump = options.dump_fallback_impact.as_ref();
     for _ in 0..steps {
         let time = sw.time + dt;
-        let reports = match sw.step() {
-            Ok(r) => r,
-            Err(e) => {
-                if let Some(path) = &options.dump_failed_impact {
-                    let json = serde_json::to_string_pretty(&impact_input_json(&sw))?;
-                    std::fs::write(path, json)?;
-                }
-                return Err(e.context(format!("at t = {time:.6} s")));
-            }
-        };
+        let reports = sw.step();
+        let fallback = reports.iter().any(|r| r.resolution != Resolution::Lzb);
         impacts.extend(reports.iter().map(|&report| TimedImpact { time, report }));
+        if fallback {
+            if let Some(path) = dump.take() {
+                let json = serde_json::to_string_pretty(&impact_input_json(&sw))?;
+                std::fs::write(path, json)?;
+            }
+        }
         taken += 1;
         if let Some(row) = &sw.row {
             hits.update(&sw, time, dt);
@@ -221,18 +213,19 @@ pub fn run_scene(
         .iter()
         .map(|(name, h, _)| {
             let rb = &sw.world.bodies[*h];
-            let c = rb.center_of_mass();
+            let (c, v) = (rb.center_of_mass(), rb.linvel());
             BodyState {
                 name: name.clone(),
-                position: [c.x, c.y],
-                angle: rb.rotation().angle(),
-                velocity: [rb.linvel().x, rb.linvel().y],
-                angular_velocity: rb.angvel(),
+                position: [f64::from(c.x), f64::from(c.y)],
+                angle: f64::from(rb.rotation().angle()),
+                velocity: [f64::from(v.x), f64::from(v.y)],
+                angular_velocity: f64::from(rb.angvel()),
             }
         })
         .collect();
     Ok(SceneOutput {
         engine,
+        precision: super::PRECISION,
         time: sw.time,
         steps: taken,
         bodies,
@@ -241,12 +234,4 @@ pub fn run_scene(
         stats: sw.topple.stats(),
         row,
     })
-}
-
-/// Reads and parses a scene file.
-pub fn load_scene(path: &std::path::Path) -> anyhow::Result<Scene> {
-    use anyhow::Context;
-    let text =
-        std::fs::read_to_string(path).with_context(|| format!("reading {}", path.display()))?;
-    toml::from_str(&text).with_context(|| format!("parsing {}", path.display()))
 }

@@ -3,41 +3,21 @@
 use std::collections::HashMap;
 
 use anyhow::{bail, Context};
-use rapier2d_f64::prelude::{
+
+use super::backend::math::Real;
+use super::backend::prelude::{
     ColliderBuilder, ColliderHandle, IntegrationParameters, PhysicsWorld, RigidBodyBuilder,
     RigidBodyHandle, Vector,
 };
+use super::ToppleRapier;
+use crate::coupling::ImpactReport;
+use crate::rapier::scene::{
+    expand_row, pair_material, topple_settings, Engine, PairLaw, Preset, Scene, ShapeKind,
+};
 
-use crate::impact::{ContactMaterial, ImpactSettings};
-use crate::rapier::{ImpactReport, PairMaterial, PatchRule, ToppleRapier, ToppleSettings};
-
-use super::format::{PairLaw, Scene, ShapeKind, SolverSpec};
-use super::row::{expand_row, Preset};
-
-/// Who resolves impacts.
-///
-/// ```
-/// use topple::rapier::scene::Engine;
-/// assert_eq!(Engine::RapierNative.name(), "rapier-native");
-/// ```
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Default, serde::Serialize, clap::ValueEnum)]
-#[serde(rename_all = "kebab-case")]
-pub enum Engine {
-    /// Rapier with topple's LZB impacts and λ-point contact.
-    #[default]
-    Rapier,
-    /// Rapier alone (same materials per pair, Rapier's own restitution).
-    RapierNative,
-}
-
-impl Engine {
-    /// The name used on the command line and in JSON.
-    pub fn name(self) -> &'static str {
-        match self {
-            Engine::Rapier => "rapier",
-            Engine::RapierNative => "rapier-native",
-        }
-    }
+/// A vector of this build from f64 components.
+fn vector(v: [f64; 2]) -> Vector {
+    Vector::new(v[0] as Real, v[1] as Real)
 }
 
 /// A row's geometry, kept for the wave measures.
@@ -67,44 +47,11 @@ pub struct SceneWorld {
     pub time: f64,
 }
 
-fn pair_material(l: &PairLaw) -> PairMaterial {
-    PairMaterial::from_table(
-        ContactMaterial {
-            stiffness: l.stiffness,
-            exponent: l.exponent,
-            restitution: l.restitution,
-            friction: l.friction,
-            stick_friction: l.stick_friction,
-        },
-        l.friction,
-        l.stick_friction,
-        l.restitution,
-        l.impact_friction_factor,
-    )
-}
-
-/// topple's settings from a scene's solver section and gravity (m/s²).
-pub fn topple_settings(s: &SolverSpec, gravity: [f64; 2]) -> ToppleSettings {
-    let g = gravity[0].hypot(gravity[1]);
-    ToppleSettings {
-        impact: match s.tolerance {
-            Some(t) => ImpactSettings::adaptive(t),
-            None => ImpactSettings::fixed(s.impulse_step),
-        },
-        patch: PatchRule {
-            closed_tolerance: s.closed_tolerance,
-            lambda: s.lambda,
-            ..PatchRule::default()
-        },
-        min_approach_speed: s.min_approach_speed.unwrap_or((2.0 * g * s.dt).max(1e-3)),
-        max_group_hops: s.max_group_hops,
-    }
-}
-
 /// Builds the world of a scene for an engine.
 ///
 /// ```
-/// use topple::rapier::scene::{build, Engine, Scene};
+/// use topple::rapier::f64::build;
+/// use topple::rapier::scene::{Engine, Scene};
 /// let scene: Scene = toml::from_str(r#"
 ///     duration = 0.1
 ///     [row]
@@ -114,7 +61,7 @@ pub fn topple_settings(s: &SolverSpec, gravity: [f64; 2]) -> ToppleSettings {
 /// "#).unwrap();
 /// let mut sw = build(&scene, Engine::Rapier).unwrap();
 /// assert_eq!(sw.bodies.len(), 3);
-/// sw.step().unwrap();
+/// sw.step();
 /// assert!(sw.kinetic_energy() > 0.0); // block 1 is pushed
 /// ```
 pub fn build(scene: &Scene, engine: Engine) -> anyhow::Result<SceneWorld> {
@@ -124,20 +71,34 @@ pub fn build(scene: &Scene, engine: Engine) -> anyhow::Result<SceneWorld> {
         None => None,
     };
     let s = &scene.solver;
-    if !(s.dt > 0.0 && s.length_unit > 0.0 && scene.duration >= 0.0) {
+    let length_unit = s
+        .length_unit
+        .unwrap_or(row.as_ref().map_or(1.0, |(preset, _)| preset.height));
+    if !(s.dt > 0.0 && length_unit > 0.0 && scene.duration >= 0.0) {
         bail!("dt and length_unit must be > 0 and duration >= 0");
     }
+    if s.contact_hertz.is_some_and(|f| !(f > 0.0 && f.is_finite())) {
+        bail!("contact_hertz must be > 0 and finite");
+    }
     let mut world = PhysicsWorld {
-        gravity: Vector::new(scene.gravity[0], scene.gravity[1]),
+        gravity: vector(scene.gravity),
         integration_parameters: IntegrationParameters {
-            dt: s.dt,
-            length_unit: s.length_unit,
+            dt: s.dt as Real,
+            length_unit: length_unit as Real,
             num_solver_iterations: s.iterations.max(1),
             contact_recycling: s.contact_recycling,
             ..IntegrationParameters::default()
         },
         ..PhysicsWorld::default()
     };
+    let hertz = s
+        .contact_hertz
+        .or(row.as_ref().map(|_| crate::rapier::ROW_CONTACT_HERTZ));
+    if let Some(f) = hertz {
+        let p = &mut world.integration_parameters;
+        p.contact_softness.natural_frequency = f as Real;
+        p.static_contact_softness.natural_frequency = (2.0 * f) as Real;
+    }
     let mut topple = match engine {
         Engine::Rapier => ToppleRapier::new(topple_settings(s, scene.gravity)),
         Engine::RapierNative => ToppleRapier::native(),
@@ -180,7 +141,7 @@ pub fn build(scene: &Scene, engine: Engine) -> anyhow::Result<SceneWorld> {
     if let Some(g) = &scene.ground {
         let m = id(&g.material)?;
         let (_, c) = world.insert(
-            RigidBodyBuilder::fixed().translation(Vector::new(0.0, g.y - 1.0)),
+            RigidBodyBuilder::fixed().translation(vector([0.0, g.y - 1.0])),
             ColliderBuilder::cuboid(1.0e3, 1.0),
         );
         topple.manage(&mut world.colliders, c, m);
@@ -194,28 +155,28 @@ pub fn build(scene: &Scene, engine: Engine) -> anyhow::Result<SceneWorld> {
                 let [w, h] = b
                     .size
                     .with_context(|| format!("body {name}: a box needs size"))?;
-                ColliderBuilder::cuboid(0.5 * w, 0.5 * h)
+                ColliderBuilder::cuboid((0.5 * w) as Real, (0.5 * h) as Real)
             }
             ShapeKind::Ball => {
                 let r = b
                     .radius
                     .with_context(|| format!("body {name}: a ball needs radius"))?;
-                ColliderBuilder::ball(r)
+                ColliderBuilder::ball(r as Real)
             }
         };
         collider = match (b.mass, b.density) {
-            (Some(mass), _) => collider.mass(mass),
-            (None, d) => collider.density(d.unwrap_or(1000.0)),
+            (Some(mass), _) => collider.mass(mass as Real),
+            (None, d) => collider.density(d.unwrap_or(1000.0) as Real),
         };
         let body = if b.fixed {
             RigidBodyBuilder::fixed()
         } else {
             RigidBodyBuilder::dynamic()
         }
-        .translation(Vector::new(b.position[0], b.position[1]))
-        .rotation(b.angle)
-        .linvel(Vector::new(b.velocity[0], b.velocity[1]))
-        .angvel(b.angular_velocity);
+        .translation(vector(b.position))
+        .rotation(b.angle as Real)
+        .linvel(vector(b.velocity))
+        .angvel(b.angular_velocity as Real);
         let (h, c) = world.insert(body, collider);
         topple.manage(&mut world.colliders, c, m);
         bodies.push((name, h, c));
@@ -236,18 +197,18 @@ pub fn build(scene: &Scene, engine: Engine) -> anyhow::Result<SceneWorld> {
 }
 
 impl SceneWorld {
-    /// One time step; returns the impacts topple resolved after it.
-    pub fn step(&mut self) -> anyhow::Result<&[ImpactReport]> {
-        self.topple.step(&mut self.world)?;
-        self.time += self.world.integration_parameters.dt;
-        Ok(self.topple.last_impacts())
+    /// One time step; returns the impacts topple resolved in it.
+    pub fn step(&mut self) -> &[ImpactReport] {
+        self.topple.step(&mut self.world);
+        self.time += f64::from(self.world.integration_parameters.dt);
+        self.topple.last_impacts()
     }
 
     /// Kinetic energy of all bodies (J per unit depth).
     pub fn kinetic_energy(&self) -> f64 {
         self.bodies
             .iter()
-            .map(|b| self.world.bodies[b.1].kinetic_energy())
+            .map(|b| f64::from(self.world.bodies[b.1].kinetic_energy()))
             .sum()
     }
 }

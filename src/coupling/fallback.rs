@@ -1,0 +1,203 @@
+//! The policy for an impact the LZB law cannot finish, shared by every engine.
+//!
+//! An impact is first solved with the paper's law (errata §2: an e = 0 contact
+//! releases its energy when its compression ends and loads again from zero if
+//! it is still pushed). A group that stays wedged — blocks pressed between
+//! their neighbours and the ground — goes through ever smaller release and
+//! reload cycles, and the impulse steps pile up. The policy, in order:
+//!
+//! | stage | when | what | counted as |
+//! | --- | --- | --- | --- |
+//! | LZB | always first | the resolver with the caller's settings | [`Resolution::Lzb`] |
+//! | held | the first attempt ran out of its budget ([`FallbackPolicy::held_retry_after`]) and the group has e = 0 contacts | solved again with those contacts held closed once their compression ends (`ImpactSettings::e0_hold`, the limit of the cycles) | [`Resolution::Held`] |
+//! | plastic | still unfinished, or the state became non-finite | every contact plastic with Coulomb friction ([`super::PlasticSolver`]) | [`Resolution::Plastic`] |
+//!
+//! A stage whose result has more kinetic energy than the group had before
+//! (beyond rounding) counts as unfinished: the law never creates energy, so
+//! that is a failed integration, never an answer.
+//!
+//! Invalid input (a NaN velocity, a zero mass) is never resolved: the error
+//! is returned before any stepping and the caller keeps its velocities (the
+//! engines count it as [`Resolution::Rejected`]). No other error leaves the
+//! policy, so a game step never fails because of an impact.
+
+use serde::{Deserialize, Serialize};
+
+use crate::impact::{Body, Contact, ImpactError, ImpactOutcome, ImpactSettings, ImpactSolver};
+
+use super::plastic::PlasticSolver;
+
+/// Budgets of the fallback policy.
+///
+/// ```
+/// use topple::coupling::FallbackPolicy;
+/// let p = FallbackPolicy::default();
+/// assert!(p.held_retry_after < p.max_steps);
+/// ```
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct FallbackPolicy {
+    /// Impulse steps the first attempt may take when the group has e = 0
+    /// contacts (then the held retry); a group without them gets
+    /// [`FallbackPolicy::max_steps`].
+    pub held_retry_after: usize,
+    /// Impulse steps of any single attempt at most (then the next stage).
+    pub max_steps: usize,
+}
+
+impl Default for FallbackPolicy {
+    fn default() -> Self {
+        FallbackPolicy {
+            held_retry_after: 20_000,
+            max_steps: 200_000,
+        }
+    }
+}
+
+/// How an impact was resolved (see the module table).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Resolution {
+    /// The LZB law finished within its budget.
+    #[default]
+    Lzb,
+    /// Solved again with the e = 0 contacts held closed.
+    Held,
+    /// Resolved as a plastic impact.
+    Plastic,
+    /// Invalid input: not resolved, the velocities were left as they were.
+    Rejected,
+}
+
+/// The LZB resolver with the fallback policy; keeps its buffers.
+///
+/// ```
+/// use topple::coupling::{FallbackPolicy, GroupSolver, Resolution};
+/// use topple::impact::{Body, Contact, ContactMaterial, ImpactOutcome, ImpactSettings};
+/// let bodies = [Body::new(1.0, 0.01).with_velocity([2.0, 0.0])];
+/// let wall = Contact::new([Some(0), None], [0.1, 0.0], [1.0, 0.0],
+///                         ContactMaterial::hertz(1e8).with_restitution(0.5));
+/// let mut out = ImpactOutcome::default();
+/// let how = GroupSolver::default()
+///     .solve_into(&bodies, &[wall], &ImpactSettings::adaptive(1e-6), &FallbackPolicy::default(), &mut out)
+///     .unwrap();
+/// assert_eq!(how, Resolution::Lzb);
+/// assert!((out.bodies[0].velocity[0] + 1.0).abs() < 1e-3); // e = 0.5
+/// ```
+#[derive(Debug, Default)]
+pub struct GroupSolver {
+    lzb: ImpactSolver,
+    plastic: PlasticSolver,
+}
+
+/// Kinetic energy after the impact exceeds the energy before by more than
+/// rounding (10⁻⁹ relative): the LZB law never creates energy (e ≤ 1,
+/// friction dissipates), so such a result is a failed integration (an
+/// adaptive step far too coarse) and goes to the next stage.
+fn gains_energy(out: &ImpactOutcome) -> bool {
+    out.kinetic_energy_after > out.kinetic_energy_before * (1.0 + 1e-9) + f64::MIN_POSITIVE
+}
+
+fn unfinished(r: &Result<(), ImpactError>) -> bool {
+    matches!(
+        r,
+        Err(ImpactError::StepLimit { .. } | ImpactError::NonFinite { .. })
+    )
+}
+
+impl GroupSolver {
+    /// Resolves one impact group into `out` by the policy. Errors only for
+    /// invalid input, before any stepping.
+    pub fn solve_into(
+        &mut self,
+        bodies: &[Body],
+        contacts: &[Contact],
+        settings: &ImpactSettings,
+        policy: &FallbackPolicy,
+        out: &mut ImpactOutcome,
+    ) -> Result<Resolution, ImpactError> {
+        let can_hold = !settings.e0_hold && contacts.iter().any(|c| c.material.restitution == 0.0);
+        let budget = if can_hold {
+            policy.held_retry_after.min(policy.max_steps)
+        } else {
+            policy.max_steps
+        };
+        let first = ImpactSettings {
+            max_steps: budget.min(settings.max_steps).max(1),
+            ..*settings
+        };
+        let result = self.lzb.solve_into(bodies, contacts, &first, out);
+        if !unfinished(&result) && !gains_energy(out) {
+            return result.map(|()| Resolution::Lzb);
+        }
+        if can_hold {
+            let held = ImpactSettings {
+                e0_hold: true,
+                max_steps: policy.max_steps.min(settings.max_steps).max(1),
+                ..*settings
+            };
+            let result = self.lzb.solve_into(bodies, contacts, &held, out);
+            if !unfinished(&result) && !gains_energy(out) {
+                return result.map(|()| Resolution::Held);
+            }
+        }
+        self.plastic.solve_into(bodies, contacts, out);
+        Ok(Resolution::Plastic)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::impact::ContactMaterial;
+
+    fn wedge() -> (Vec<Body>, Vec<Contact>) {
+        // a ball driven into a corner between two walls with e = 0
+        let bodies = vec![Body::new(1.0, 0.004).with_velocity([1.0, -1.0])];
+        let m = ContactMaterial::hertz(1e8).with_restitution(0.0);
+        let contacts = vec![
+            Contact::new([Some(0), None], [0.1, 0.0], [1.0, 0.0], m),
+            Contact::new([None, Some(0)], [0.0, -0.1], [0.0, 1.0], m),
+        ];
+        (bodies, contacts)
+    }
+
+    #[test]
+    fn a_tiny_budget_ends_held_or_plastic_and_never_creates_energy() {
+        let (bodies, contacts) = wedge();
+        let mut out = ImpactOutcome::default();
+        let mut solver = GroupSolver::default();
+        let tight = FallbackPolicy {
+            held_retry_after: 3,
+            max_steps: 4,
+        };
+        let how = solver
+            .solve_into(
+                &bodies,
+                &contacts,
+                &ImpactSettings::fixed(1e-4),
+                &tight,
+                &mut out,
+            )
+            .unwrap();
+        assert!(matches!(how, Resolution::Held | Resolution::Plastic));
+        assert!(out.kinetic_energy_after <= out.kinetic_energy_before);
+        // the corner stops the ball (both walls are e = 0): at rest
+        let v = out.bodies[0].velocity;
+        assert!(v[0].abs() < 1e-6 && v[1].abs() < 1e-6, "{v:?}");
+    }
+
+    #[test]
+    fn invalid_input_is_rejected_before_stepping() {
+        let (mut bodies, contacts) = wedge();
+        bodies[0].velocity[0] = f64::NAN;
+        let mut out = ImpactOutcome::default();
+        let r = GroupSolver::default().solve_into(
+            &bodies,
+            &contacts,
+            &ImpactSettings::default(),
+            &FallbackPolicy::default(),
+            &mut out,
+        );
+        assert!(matches!(r, Err(ImpactError::InvalidBody { .. })));
+    }
+}

@@ -1,0 +1,66 @@
+//! Settings of the impact pass an engine runs at impact events.
+
+use crate::impact::ImpactSettings;
+
+use super::fallback::FallbackPolicy;
+use super::patch::PatchRule;
+
+/// Settings of the impact pass.
+///
+/// The default resolves impacts with the resolver's adaptive stepping at a
+/// relative tolerance of 10⁻⁴ (on a wedged five-block domino group:
+/// velocities within 0.5 % of the paper's fixed step ΔP = 10⁻⁴ P₀ for the
+/// struck pair, in 240 steps against 4,880); set `impact` to
+/// [`ImpactSettings::fixed`] for the paper's scheme.
+///
+/// ```
+/// use topple::coupling::ToppleSettings;
+/// let s = ToppleSettings::default();
+/// assert_eq!(s.patch.lambda, 9);
+/// ```
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ToppleSettings {
+    /// Settings handed to the LZB resolver (impulse step or tolerance).
+    pub impact: ImpactSettings,
+    /// Which manifold points are closed and how flat patches are subdivided.
+    pub patch: PatchRule,
+    /// A new closed contact starts an impact when it approaches faster than
+    /// this (m/s). Slower approaches are left to the engine's contact solver.
+    /// Keep it above about 2|g|Δt, the approach a resting contact picks up in
+    /// one step.
+    pub min_approach_speed: f64,
+    /// The window of an impact: only free bodies within this many closed
+    /// contacts of the bodies that started it take part, and contacts with
+    /// bodies beyond are left out (like the paper's active window κ). `None`:
+    /// the whole connected group. Default [`ToppleSettings::DEFAULT_WINDOW`].
+    pub max_group_hops: Option<usize>,
+    /// What happens to an impact the LZB law cannot finish.
+    pub fallback: FallbackPolicy,
+    /// An engine adapter splits its step at the predicted instant of an
+    /// impact, at most this many times per step (0: never), so that the
+    /// smooth forces after the impact act on the post-impact velocities.
+    pub max_splits: usize,
+}
+
+impl ToppleSettings {
+    /// The default impact window (closed contacts from the bodies that start
+    /// an impact): a cradle of five bodies is whole, and the leaning train
+    /// behind a domino front takes part with its three nearest blocks (on
+    /// the ideal Domino T row, s/h 0.45, at 1/60 s: v̂_na 1.685, 1.711,
+    /// 1.714, 1.705 for windows 1 to 4, at cost 1 : 0.9 : 1.1 : 1.4;
+    /// docs/game-rate.md).
+    pub const DEFAULT_WINDOW: usize = 3;
+}
+
+impl Default for ToppleSettings {
+    fn default() -> Self {
+        ToppleSettings {
+            impact: ImpactSettings::adaptive(1e-4),
+            patch: PatchRule::default(),
+            min_approach_speed: 1e-3,
+            max_group_hops: Some(Self::DEFAULT_WINDOW),
+            fallback: FallbackPolicy::default(),
+            max_splits: 4,
+        }
+    }
+}

@@ -1,0 +1,184 @@
+//! The physics hook: per-pair friction for Rapier's own solver on the pairs
+//! topple manages, with Rapier's restitution off and, in topple mode, the
+//! contact points that approach faster than the impact threshold taken from
+//! Rapier's solver, unless they belong to a lasting contact (a touching point
+//! Rapier already had at its last contact update). Rapier would stop those inelastically (a speculative
+//! point at the instant the gap closes, a touching point at once); topple
+//! resolves them instead, at the instant the pair closes
+//! ([`super::ToppleRapier`]). The hook notes each pair it took points from:
+//! those pairs are the impact candidates of the step.
+
+use std::sync::Mutex;
+
+use super::backend::geometry::NEW_CONTACT_BIT;
+use super::backend::math::Real;
+use super::backend::prelude::{
+    ColliderHandle, ContactModificationContext, PhysicsHooks, RigidBodyHandle, SolverFlags, Vector,
+};
+
+use crate::coupling::{MaterialId, MaterialTable, PairMaterial};
+use crate::rapier::HookMode;
+
+/// Materials of the managed colliders, read by the hook during Rapier's step.
+/// [`super::ToppleRapier::step`] hands it to Rapier; a caller that runs
+/// Rapier's pipeline itself hands over [`super::ToppleRapier::hooks`].
+///
+/// ```
+/// use topple::rapier2d_f64::prelude::*;
+/// use topple::coupling::{PairMaterial, ToppleSettings};
+/// use topple::impact::ContactMaterial;
+/// use topple::rapier::f64::ToppleRapier;
+/// let mut colliders = ColliderSet::new();
+/// let c = colliders.insert(ColliderBuilder::ball(0.1));
+/// let mut topple = ToppleRapier::new(ToppleSettings::default());
+/// let m = topple.add_material(PairMaterial { impact: ContactMaterial::hertz(1e9), smooth_friction: 0.4 });
+/// topple.manage(&mut colliders, c, m);
+/// assert_eq!(topple.hooks().material_of(c), Some(m));
+/// assert_eq!(topple.hooks().pair(c, c).unwrap().smooth_friction, 0.4);
+/// ```
+#[derive(Debug)]
+pub struct ToppleHooks {
+    pub(crate) table: MaterialTable,
+    collider_material: Vec<u16>,
+    pub(crate) mode: HookMode,
+    /// Points approaching faster than this (m/s) are topple's.
+    pub(crate) min_approach_speed: f64,
+    /// Pairs the hook took points from during the current step.
+    taken: Mutex<Vec<u64>>,
+}
+
+const UNMANAGED: u16 = u16::MAX;
+
+/// A collider pair as one number (arena indices, smaller first).
+#[inline]
+pub(crate) fn pair_key(a: ColliderHandle, b: ColliderHandle) -> u64 {
+    let (a, b) = (a.into_raw_parts().0 as u64, b.into_raw_parts().0 as u64);
+    (a.min(b) << 32) | a.max(b)
+}
+
+impl ToppleHooks {
+    pub(crate) fn new(mode: HookMode) -> Self {
+        ToppleHooks {
+            table: MaterialTable::default(),
+            collider_material: Vec::new(),
+            mode,
+            min_approach_speed: 0.0,
+            taken: Mutex::new(Vec::new()),
+        }
+    }
+
+    pub(crate) fn set(&mut self, collider: ColliderHandle, material: Option<MaterialId>) {
+        let i = collider.into_raw_parts().0 as usize;
+        if self.collider_material.len() <= i {
+            self.collider_material.resize(i + 1, UNMANAGED);
+        }
+        self.collider_material[i] = material.map_or(UNMANAGED, |m| m.0);
+    }
+
+    /// Moves the pairs noted during the step into `out` (appended).
+    pub(crate) fn take_noted(&self, out: &mut Vec<u64>) {
+        let mut taken = self.taken.lock().unwrap_or_else(|e| e.into_inner());
+        out.append(&mut taken);
+    }
+
+    /// Who resolves impacts.
+    pub fn mode(&self) -> HookMode {
+        self.mode
+    }
+
+    /// The material of a collider, if topple manages it.
+    #[inline]
+    pub fn material_of(&self, collider: ColliderHandle) -> Option<MaterialId> {
+        match self
+            .collider_material
+            .get(collider.into_raw_parts().0 as usize)
+        {
+            Some(&m) if m != UNMANAGED => Some(MaterialId(m)),
+            _ => None,
+        }
+    }
+
+    /// The pair material of two colliders, if topple manages both.
+    #[inline]
+    pub fn pair(&self, a: ColliderHandle, b: ColliderHandle) -> Option<&PairMaterial> {
+        Some(self.table.pair(self.material_of(a)?, self.material_of(b)?))
+    }
+
+    /// What the hook does to one managed pair's solver contacts (see the
+    /// module docs); public so that an app with hooks of its own can call it
+    /// from them. Returns `false` for a pair topple does not manage.
+    pub fn modify(&self, context: &mut ContactModificationContext) -> bool {
+        let Some(pair) = self.pair(context.collider1, context.collider2) else {
+            return false;
+        };
+        *context.friction = pair.smooth_friction as Real;
+        if self.mode == HookMode::Native {
+            *context.restitution = pair.impact.restitution as Real;
+            return true;
+        }
+        *context.restitution = 0.0;
+        let n = *context.normal;
+        let bodies = context.bodies;
+        let velocity = |h: Option<RigidBodyHandle>, p: Vector| {
+            h.and_then(|h| bodies.get(h))
+                .map(|rb| rb.velocity_at_point(p))
+                .unwrap_or_default()
+        };
+        let (b1, b2) = (context.rigid_body1, context.rigid_body2);
+        let threshold = self.min_approach_speed as Real;
+        let before = context.solver_contacts.len();
+        context.solver_contacts.retain(|c| {
+            // Rapier's own notion of a lasting contact: the point existed at
+            // the last contact update and touches. Its approach in discrete
+            // time (of order g·Δt and v_t·ω·Δt on a sliding or pivoting
+            // contact) is Rapier's to hold.
+            let lasting = c.contact_id[0] & NEW_CONTACT_BIT == 0 && c.dist <= 0.0;
+            let vn = (velocity(b2, c.anchor2) - velocity(b1, c.anchor1)).dot(n);
+            lasting || vn >= -threshold
+        });
+        if context.solver_contacts.len() < before {
+            let key = pair_key(context.collider1, context.collider2);
+            self.taken
+                .lock()
+                .unwrap_or_else(|e| e.into_inner())
+                .push(key);
+        }
+        true
+    }
+}
+
+impl PhysicsHooks for ToppleHooks {
+    fn modify_solver_contacts(&self, context: &mut ContactModificationContext) {
+        self.modify(context);
+    }
+}
+
+/// topple's hook in front of an app's own: topple modifies the managed
+/// pairs' solver contacts first, then the app's hook sees every pair.
+pub struct ChainedHooks<'a> {
+    /// topple's hook.
+    pub topple: &'a ToppleHooks,
+    /// The app's hook.
+    pub user: &'a dyn PhysicsHooks,
+}
+
+impl PhysicsHooks for ChainedHooks<'_> {
+    fn filter_contact_pair(
+        &self,
+        context: &super::backend::prelude::PairFilterContext,
+    ) -> Option<SolverFlags> {
+        self.user.filter_contact_pair(context)
+    }
+
+    fn filter_intersection_pair(
+        &self,
+        context: &super::backend::prelude::PairFilterContext,
+    ) -> bool {
+        self.user.filter_intersection_pair(context)
+    }
+
+    fn modify_solver_contacts(&self, context: &mut ContactModificationContext) {
+        self.topple.modify(context);
+        self.user.modify_solver_contacts(context);
+    }
+}

@@ -1,0 +1,385 @@
+//! The Rapier adapter (one source for rapier2d-f64 and rapier2d): Rapier's
+//! step with topple's hook, then the impact pass ([`super::pass`]) that
+//! resolves each impact at the instant its pair closes inside the step.
+//! Everything physical lives in the engine-agnostic [`crate::coupling`].
+
+use std::time::Instant;
+
+use super::backend::math::Real;
+use super::backend::prelude::{
+    ActiveHooks, BroadPhaseBvh, CCDSolver, ColliderHandle, ColliderSet, EventHandler,
+    ImpulseJointSet, IntegrationParameters, IslandManager, MultibodyJointSet, NarrowPhase,
+    PhysicsHooks, PhysicsPipeline, PhysicsWorld, RigidBodyHandle, RigidBodySet, Vector,
+};
+
+use super::hooks::{ChainedHooks, ToppleHooks};
+use super::pass::{ImpactContact, ImpactEvent, ImpactPass, World};
+use crate::coupling::{ImpactGroups, ImpactReport, MaterialId, PairMaterial, ToppleSettings};
+use crate::rapier::{HookMode, ToppleStats};
+
+/// The parts of a Rapier simulation one step needs, borrowed from wherever
+/// the app keeps them (a [`PhysicsWorld`], or bevy_rapier's components).
+pub struct StepParts<'a> {
+    /// Rapier's pipeline.
+    pub pipeline: &'a mut PhysicsPipeline,
+    /// Gravity (m/s²).
+    pub gravity: Vector,
+    /// Rapier's parameters; `dt` is the step (s).
+    pub integration_parameters: &'a IntegrationParameters,
+    /// Rapier's island manager.
+    pub islands: &'a mut IslandManager,
+    /// Rapier's broad phase.
+    pub broad_phase: &'a mut BroadPhaseBvh,
+    /// Rapier's narrow phase.
+    pub narrow_phase: &'a mut NarrowPhase,
+    /// The bodies.
+    pub bodies: &'a mut RigidBodySet,
+    /// The colliders.
+    pub colliders: &'a mut ColliderSet,
+    /// Impulse joints.
+    pub impulse_joints: &'a mut ImpulseJointSet,
+    /// Multibody joints.
+    pub multibody_joints: &'a mut MultibodyJointSet,
+    /// Rapier's CCD solver.
+    pub ccd_solver: &'a mut CCDSolver,
+}
+
+impl<'a> StepParts<'a> {
+    /// The parts of a [`PhysicsWorld`].
+    pub fn of(world: &'a mut PhysicsWorld) -> Self {
+        StepParts {
+            pipeline: &mut world.physics_pipeline,
+            gravity: world.gravity,
+            integration_parameters: &world.integration_parameters,
+            islands: &mut world.islands,
+            broad_phase: &mut world.broad_phase,
+            narrow_phase: &mut world.narrow_phase,
+            bodies: &mut world.bodies,
+            colliders: &mut world.colliders,
+            impulse_joints: &mut world.impulse_joints,
+            multibody_joints: &mut world.multibody_joints,
+            ccd_solver: &mut world.ccd_solver,
+        }
+    }
+}
+
+/// LZB impacts for a Rapier world.
+///
+/// Register the colliders topple manages with a material and step the world
+/// with [`ToppleRapier::step`] (a [`PhysicsWorld`]) or
+/// [`ToppleRapier::step_parts`] (the parts of a simulation kept elsewhere,
+/// as bevy_rapier does). Pairs of managed colliders get their impacts from
+/// the LZB resolver, at the instant the pair closes inside the step;
+/// everything else is plain Rapier.
+///
+/// ```
+/// use topple::rapier2d_f64::prelude::*;
+/// use topple::coupling::{PairMaterial, ToppleSettings};
+/// use topple::impact::ContactMaterial;
+/// use topple::rapier::f64::ToppleRapier;
+///
+/// let mut world = PhysicsWorld::default();
+/// world.gravity = Vector::ZERO;
+/// let mut topple = ToppleRapier::new(ToppleSettings::default());
+/// let steel = topple.add_material(PairMaterial {
+///     impact: ContactMaterial::hertz(1e10),
+///     smooth_friction: 0.0,
+/// });
+/// // a cradle of two touching balls, the first moving at 1 m/s
+/// let mut balls = Vec::new();
+/// for (x, v) in [(0.0, 1.0), (0.2, 0.0)] {
+///     let (body, collider) = world.insert(
+///         RigidBodyBuilder::dynamic().translation(Vector::new(x, 0.0)).linvel(Vector::new(v, 0.0)),
+///         ColliderBuilder::ball(0.1),
+///     );
+///     topple.manage(&mut world.colliders, collider, steel);
+///     balls.push(body);
+/// }
+/// topple.step(&mut world);
+/// assert!(world.bodies[balls[0]].linvel().x.abs() < 1e-3);
+/// assert!((world.bodies[balls[1]].linvel().x - 1.0).abs() < 1e-3);
+/// ```
+#[derive(Debug)]
+pub struct ToppleRapier {
+    hooks: ToppleHooks,
+    settings: ToppleSettings,
+    pass: ImpactPass,
+    stats: ToppleStats,
+}
+
+impl ToppleRapier {
+    /// topple resolving impacts with the given settings.
+    pub fn new(settings: ToppleSettings) -> Self {
+        Self::with_mode(settings, HookMode::Topple)
+    }
+
+    /// A native-Rapier twin: the same per-pair friction and restitution, but
+    /// Rapier resolves impacts and the impact pass does nothing. For
+    /// comparisons.
+    pub fn native() -> Self {
+        Self::with_mode(ToppleSettings::default(), HookMode::Native)
+    }
+
+    fn with_mode(settings: ToppleSettings, mode: HookMode) -> Self {
+        let mut topple = ToppleRapier {
+            hooks: ToppleHooks::new(mode),
+            settings,
+            pass: ImpactPass::default(),
+            stats: ToppleStats::default(),
+        };
+        topple.set_settings(settings);
+        topple
+    }
+
+    /// The settings of the impact pass.
+    pub fn settings(&self) -> &ToppleSettings {
+        &self.settings
+    }
+
+    /// Changes the settings (between steps).
+    pub fn set_settings(&mut self, settings: ToppleSettings) {
+        self.settings = settings;
+        self.hooks.min_approach_speed = settings.min_approach_speed;
+    }
+
+    /// Adds a material; returns its id.
+    pub fn add_material(&mut self, material: PairMaterial) -> MaterialId {
+        self.hooks.table.add(material)
+    }
+
+    /// Sets the material between colliders of materials `a` and `b`.
+    pub fn set_pair_material(&mut self, a: MaterialId, b: MaterialId, material: PairMaterial) {
+        self.hooks.table.set_pair(a, b, material);
+    }
+
+    /// Lets topple manage a collider with the given material (and turns on
+    /// the collider's contact-modification hook). An unknown material id is
+    /// ignored (the collider stays native) and reported as `false`.
+    pub fn manage(
+        &mut self,
+        colliders: &mut ColliderSet,
+        collider: ColliderHandle,
+        material: MaterialId,
+    ) -> bool {
+        let Some(co) = colliders.get_mut(collider) else {
+            return false;
+        };
+        if (material.0 as usize) >= self.hooks.table.len() {
+            return false;
+        }
+        self.hooks.set(collider, Some(material));
+        co.set_active_hooks(co.active_hooks() | ActiveHooks::MODIFY_SOLVER_CONTACTS);
+        true
+    }
+
+    /// Gives a collider back to Rapier (its hook flag is left as it is: the
+    /// hook leaves unmanaged pairs alone).
+    pub fn unmanage(&mut self, collider: ColliderHandle) {
+        self.hooks.set(collider, None);
+    }
+
+    /// The hook to hand to `PhysicsPipeline::step` when the app steps
+    /// Rapier itself (then call [`ToppleRapier::step_parts`] instead, which
+    /// does both).
+    pub fn hooks(&self) -> &ToppleHooks {
+        &self.hooks
+    }
+
+    /// The impacts resolved in the last step, one report per group.
+    pub fn last_impacts(&self) -> &[ImpactReport] {
+        &self.pass.reports
+    }
+
+    /// The impact groups of the last step with their instants; their bodies
+    /// and contacts are in [`ToppleRapier::event_bodies`] and
+    /// [`ToppleRapier::event_contacts`].
+    pub fn last_events(&self) -> &[ImpactEvent] {
+        &self.pass.events
+    }
+
+    /// The bodies of an event of the last step.
+    pub fn event_bodies(&self, event: &ImpactEvent) -> &[RigidBodyHandle] {
+        &self.pass.event_bodies[event.bodies.0..event.bodies.1]
+    }
+
+    /// The contacts of an event of the last step, with their impulses.
+    pub fn event_contacts(&self, event: &ImpactEvent) -> &[ImpactContact] {
+        &self.pass.event_contacts[event.contacts.0..event.contacts.1]
+    }
+
+    /// The grouping stage (its last group in the input form of `topple
+    /// impact`).
+    pub fn impact_groups(&self) -> &ImpactGroups {
+        self.pass.groups()
+    }
+
+    /// Totals since creation.
+    pub fn stats(&self) -> ToppleStats {
+        let mut s = self.stats;
+        s.pairs_queried = self.pass.pairs_queried;
+        s.contact_points = self.pass.contact_points;
+        s
+    }
+
+    /// One step of a [`PhysicsWorld`] (see [`ToppleRapier::step_parts`]).
+    pub fn step(&mut self, world: &mut PhysicsWorld) -> usize {
+        self.step_parts(StepParts::of(world), &(), &())
+    }
+
+    /// One Rapier step with topple's hook in front of `user_hooks`, then the
+    /// impact pass: every impact of a managed pair is resolved at the instant
+    /// the pair closed, the bodies it changed move on from there to the end
+    /// of the step. Returns the number of impact groups resolved. Never
+    /// fails: an impact the LZB law cannot finish goes through the fallback
+    /// policy (counted in [`ToppleRapier::stats`]). The same as
+    /// [`ToppleRapier::begin_step`], Rapier's step with
+    /// [`ToppleRapier::hooks`], then [`ToppleRapier::end_step`].
+    pub fn step_parts(
+        &mut self,
+        parts: StepParts<'_>,
+        user_hooks: &dyn PhysicsHooks,
+        events: &dyn EventHandler,
+    ) -> usize {
+        self.pass.clear_step();
+        let dt = parts.integration_parameters.dt;
+        let mut params = *parts.integration_parameters;
+        let (mut done, mut groups) = (0.0 as Real, 0);
+        for split in 0..=self.settings.max_splits {
+            let remaining = dt - done;
+            self.begin_step(parts.islands, parts.bodies);
+            let h = if split < self.settings.max_splits {
+                self.split_length(&parts, remaining)
+            } else {
+                remaining
+            };
+            params.dt = h;
+            let hooks = ChainedHooks {
+                topple: &self.hooks,
+                user: user_hooks,
+            };
+            parts.pipeline.step(
+                parts.gravity,
+                &params,
+                parts.islands,
+                parts.broad_phase,
+                parts.narrow_phase,
+                parts.bodies,
+                parts.colliders,
+                parts.impulse_joints,
+                parts.multibody_joints,
+                parts.ccd_solver,
+                &hooks,
+                events,
+            );
+            groups += self.pass_after(
+                parts.bodies,
+                parts.colliders,
+                parts.narrow_phase,
+                parts.broad_phase,
+                &params,
+                f64::from(done),
+            );
+            done += h;
+            if h >= remaining {
+                break;
+            }
+        }
+        groups
+    }
+
+    /// How far to step Rapier now: to the predicted instant of the next
+    /// impact within `remaining` (s), or all of it. Pieces shorter than 1/64
+    /// of `remaining` are not split off.
+    fn split_length(&mut self, parts: &StepParts<'_>, remaining: Real) -> Real {
+        if self.hooks.mode != HookMode::Topple {
+            return remaining;
+        }
+        let start = Instant::now();
+        let params = parts.integration_parameters;
+        let world = World {
+            bodies: parts.bodies,
+            colliders: parts.colliders,
+            narrow_phase: parts.narrow_phase,
+            broad_phase: parts.broad_phase,
+            prediction: f64::from(params.prediction_distance()),
+            allowed: f64::from(params.allowed_linear_error()),
+        };
+        let horizon = f64::from(remaining);
+        let predicted = self
+            .pass
+            .predict(&world, &self.hooks, &self.settings, horizon);
+        self.stats.topple_seconds += start.elapsed().as_secs_f64();
+        match predicted {
+            Some(t) if t > horizon / 64.0 && t < horizon * (1.0 - 1.0 / 64.0) => {
+                self.stats.split_steps += 1;
+                t as Real
+            }
+            _ => remaining,
+        }
+    }
+
+    /// Before Rapier's step: records where the awake bodies start from.
+    pub fn begin_step(&mut self, islands: &IslandManager, bodies: &RigidBodySet) {
+        if self.hooks.mode == HookMode::Topple {
+            let start = Instant::now();
+            self.pass.motion.record_start(islands, bodies);
+            self.stats.topple_seconds += start.elapsed().as_secs_f64();
+        }
+    }
+
+    /// After Rapier's step (run with [`ToppleRapier::hooks`]): the impact
+    /// pass and the new velocities and poses written back. Returns the
+    /// number of impact groups resolved.
+    pub fn end_step(
+        &mut self,
+        bodies: &mut RigidBodySet,
+        colliders: &ColliderSet,
+        narrow_phase: &NarrowPhase,
+        broad_phase: &BroadPhaseBvh,
+        integration_parameters: &IntegrationParameters,
+    ) -> usize {
+        self.pass.clear_step();
+        self.pass_after(
+            bodies,
+            colliders,
+            narrow_phase,
+            broad_phase,
+            integration_parameters,
+            0.0,
+        )
+    }
+
+    /// The impact pass after one Rapier step that started `offset` (s) into
+    /// the caller's step.
+    fn pass_after(
+        &mut self,
+        bodies: &mut RigidBodySet,
+        colliders: &ColliderSet,
+        narrow_phase: &NarrowPhase,
+        broad_phase: &BroadPhaseBvh,
+        integration_parameters: &IntegrationParameters,
+        offset: f64,
+    ) -> usize {
+        if self.hooks.mode != HookMode::Topple {
+            return 0;
+        }
+        let start = Instant::now();
+        let world = World {
+            bodies,
+            colliders,
+            narrow_phase,
+            broad_phase,
+            prediction: f64::from(integration_parameters.prediction_distance()),
+            allowed: f64::from(integration_parameters.allowed_linear_error()),
+        };
+        let first = self.pass.reports.len();
+        let dt: Real = integration_parameters.dt;
+        let groups = self
+            .pass
+            .run(&world, &self.hooks, &self.settings, dt, offset);
+        self.pass.write_back(bodies);
+        self.stats.record(&self.pass.reports[first..]);
+        self.stats.topple_seconds += start.elapsed().as_secs_f64();
+        groups
+    }
+}

@@ -1,0 +1,36 @@
+//! topple on `rapier2d-f64` (the crate re-exported as [`crate::rapier2d_f64`]):
+//! headless and research use, the precision of the reference engine.
+//!
+//! The items are documented once, on this build; [`super::f32`] compiles the
+//! same source for `rapier2d`.
+
+// One source compiled for two precisions: a cast or conversion that is a
+// no-op in one build is needed in the other.
+#![allow(clippy::unnecessary_cast, clippy::useless_conversion)]
+
+use ::rapier2d_f64 as backend;
+
+#[path = "adapter/chain.rs"]
+pub mod chain;
+#[path = "adapter/hooks.rs"]
+mod hooks;
+#[path = "adapter/motion.rs"]
+mod motion;
+#[path = "adapter/pass.rs"]
+mod pass;
+#[path = "adapter/scene_build.rs"]
+mod scene_build;
+#[path = "adapter/scene_run.rs"]
+mod scene_run;
+#[path = "adapter/world.rs"]
+mod world;
+
+pub use backend::math::Real;
+pub use hooks::{ChainedHooks, ToppleHooks};
+pub use pass::{ImpactContact, ImpactEvent};
+pub use scene_build::{build, RowInfo, SceneWorld};
+pub use scene_run::{impact_input_json, run_scene, signed_gap, HitTracker};
+pub use world::{StepParts, ToppleRapier};
+
+/// This build's precision.
+pub const PRECISION: crate::rapier::Precision = crate::rapier::Precision::F64;

@@ -1,0 +1,260 @@
+//! What a scene run needs that does not depend on the Rapier build: the
+//! engine choice, the settings and materials built from a scene, the output.
+
+use anyhow::Context;
+
+use crate::coupling::{FallbackPolicy, ImpactReport, PairMaterial, PatchRule, ToppleSettings};
+use crate::impact::{ContactMaterial, ImpactSettings};
+use crate::rapier::{Precision, ToppleStats};
+
+use super::format::{PairLaw, RowOverrides, RowSpec as SceneRow, Scene, SolverSpec};
+use super::row::RowMeasures;
+use crate::domino::{ChainReport, RowSpec as DominoRow};
+
+/// Who resolves impacts.
+///
+/// ```
+/// use topple::rapier::scene::Engine;
+/// assert_eq!(Engine::RapierNative.name(), "rapier-native");
+/// ```
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default, serde::Serialize, clap::ValueEnum)]
+#[serde(rename_all = "kebab-case")]
+pub enum Engine {
+    /// Rapier with topple's LZB impacts and λ-point contact.
+    #[default]
+    Rapier,
+    /// Rapier alone (same materials per pair, Rapier's own restitution).
+    RapierNative,
+}
+
+impl Engine {
+    /// The name used on the command line and in JSON.
+    pub fn name(self) -> &'static str {
+        match self {
+            Engine::Rapier => "rapier",
+            Engine::RapierNative => "rapier-native",
+        }
+    }
+}
+
+pub(crate) fn pair_material(l: &PairLaw) -> PairMaterial {
+    PairMaterial::from_table(
+        ContactMaterial {
+            stiffness: l.stiffness,
+            exponent: l.exponent,
+            restitution: l.restitution,
+            friction: l.friction,
+            stick_friction: l.stick_friction,
+        },
+        l.friction,
+        l.stick_friction,
+        l.restitution,
+        l.impact_friction_factor,
+    )
+}
+
+/// topple's settings from a scene's solver section and gravity (m/s²).
+pub fn topple_settings(s: &SolverSpec, gravity: [f64; 2]) -> ToppleSettings {
+    let g = gravity[0].hypot(gravity[1]);
+    ToppleSettings {
+        impact: match (s.tolerance, s.impulse_step) {
+            (Some(t), _) => ImpactSettings::adaptive(t),
+            (None, Some(step)) => ImpactSettings::fixed(step),
+            (None, None) => ToppleSettings::default().impact,
+        },
+        patch: PatchRule {
+            closed_tolerance: s.closed_tolerance,
+            lambda: s.lambda,
+            ..PatchRule::default()
+        },
+        min_approach_speed: s.min_approach_speed.unwrap_or((2.0 * g * s.dt).max(1e-3)),
+        max_group_hops: s
+            .max_group_hops
+            .or(ToppleSettings::default().max_group_hops),
+        fallback: FallbackPolicy::default(),
+        max_splits: s.max_splits.unwrap_or(ToppleSettings::default().max_splits),
+    }
+}
+
+/// A body's state at the end.
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+pub struct BodyState {
+    /// Name.
+    pub name: String,
+    /// Centre of mass (m).
+    pub position: [f64; 2],
+    /// Angle (rad).
+    pub angle: f64,
+    /// Velocity (m/s).
+    pub velocity: [f64; 2],
+    /// Angular velocity (rad/s).
+    pub angular_velocity: f64,
+}
+
+/// An impact with the time it was resolved.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
+pub struct TimedImpact {
+    /// Time (s).
+    pub time: f64,
+    /// What it did.
+    #[serde(flatten)]
+    pub report: ImpactReport,
+}
+
+/// What a scene run returns.
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct SceneOutput {
+    /// Engine used.
+    pub engine: Engine,
+    /// Rapier build used.
+    pub precision: Precision,
+    /// Simulated time (s).
+    pub time: f64,
+    /// Steps taken.
+    pub steps: usize,
+    /// Final body states.
+    pub bodies: Vec<BodyState>,
+    /// Kinetic energy at the start and at the end (J per unit depth).
+    pub kinetic_energy: [f64; 2],
+    /// Impacts resolved by topple (none for the native engine).
+    pub impacts: Vec<TimedImpact>,
+    /// topple's counters.
+    pub stats: ToppleStats,
+    /// Wave measures, for a scene with a row.
+    pub row: Option<RowMeasures>,
+}
+
+/// Options of [`run_scene`].
+#[derive(Clone, Debug, Default)]
+pub struct RunOptions {
+    /// Stop a row scene once its last block has been hit.
+    pub stop_after_last_hit: bool,
+    /// Write the first impact group that needed the fallback policy (held,
+    /// plastic or rejected) here, as input for `topple impact`.
+    pub dump_fallback_impact: Option<std::path::PathBuf>,
+}
+
+/// Runs a scene with an engine on the Rapier build of `precision`.
+///
+/// ```
+/// use topple::rapier::scene::{run_scene, Engine, RunOptions, Scene};
+/// use topple::rapier::Precision;
+/// let scene: Scene = toml::from_str(r#"
+///     duration = 0.01
+///     gravity = [0.0, 0.0]
+///     [[materials]]
+///     name = "steel"
+///     stiffness = 1e10
+///     [[bodies]]
+///     shape = "ball"
+///     radius = 0.05
+///     position = [0.0, 0.0]
+///     velocity = [1.0, 0.0]
+///     mass = 1.0
+///     material = "steel"
+///     [[bodies]]
+///     shape = "ball"
+///     radius = 0.05
+///     position = [0.1, 0.0]
+///     mass = 1.0
+///     material = "steel"
+/// "#).unwrap();
+/// for precision in [Precision::F64, Precision::F32] {
+///     let out = run_scene(&scene, Engine::Rapier, precision, RunOptions::default()).unwrap();
+///     assert_eq!(out.impacts.len(), 1);
+///     assert!((out.bodies[1].velocity[0] - 1.0).abs() < 1e-3);
+/// }
+/// ```
+pub fn run_scene(
+    scene: &Scene,
+    engine: Engine,
+    precision: Precision,
+    options: RunOptions,
+) -> anyhow::Result<SceneOutput> {
+    match precision {
+        Precision::F64 => crate::rapier::f64::run_scene(scene, engine, options),
+        Precision::F32 => crate::rapier::f32::run_scene(scene, engine, options),
+    }
+}
+
+/// Reads and parses a scene file.
+pub fn load_scene(path: &std::path::Path) -> anyhow::Result<Scene> {
+    let text =
+        std::fs::read_to_string(path).with_context(|| format!("reading {}", path.display()))?;
+    toml::from_str(&text).with_context(|| format!("parsing {}", path.display()))
+}
+
+/// The scene of a domino row of [`crate::domino`]: the row's every parameter
+/// as an override of the scene's row generator, Rapier's `solver` settings
+/// (its λ taken from the row), `max_time` (s) as the duration.
+pub fn row_scene(row: &DominoRow, solver: SolverSpec, max_time: f64) -> Scene {
+    let p = &row.params;
+    Scene {
+        description: String::new(),
+        duration: max_time,
+        gravity: [0.0, -p.gravity],
+        solver: SolverSpec {
+            lambda: p.lambda_points,
+            ..solver
+        },
+        materials: Vec::new(),
+        pairs: Vec::new(),
+        ground: None,
+        bodies: Vec::new(),
+        row: Some(SceneRow {
+            preset: "T".into(), // every value is overridden below
+            n: row.n,
+            spacing: row.spacing_ratio(),
+            push: row.push,
+            ideal: false,
+            density: 1000.0,
+            mass: Some(p.block.mass),
+            overrides: RowOverrides {
+                height: Some(p.block.height),
+                thickness: Some(p.block.thickness),
+                mu1: Some(p.mu1),
+                mu1_stick: Some(p.mu1_stick),
+                e1: Some(p.e1),
+                k1: Some(p.k1),
+                mu2: Some(p.mu2),
+                mu2_stick: Some(p.mu2_stick),
+                e2: Some(p.e2),
+                k2: Some(p.k2),
+                alpha: Some(p.alpha),
+                impact_friction_factor: Some(p.impact_friction_factor),
+            },
+        }),
+    }
+}
+
+/// Runs a domino row of [`crate::domino`] through Rapier (topple or native,
+/// either build) until its last block is hit, nothing was hit for 2 s, or
+/// `max_time` (s) passed; `progress` gets the number of blocks hit so far.
+///
+/// ```
+/// use topple::domino::{Preset, RowSpec};
+/// use topple::rapier::scene::{run_row, Engine, SolverSpec};
+/// use topple::rapier::Precision;
+/// let p = Preset::T.params().ideal();
+/// let row = RowSpec::new(p, 0.45 * p.block.height, 4, 1.0);
+/// let solver = SolverSpec { dt: 1.0 / 240.0, ..SolverSpec::default() };
+/// let r = run_row(&row, Engine::Rapier, Precision::F64, solver, 2.0, |_| {}).unwrap();
+/// assert_eq!(r.hit_times.len(), 4); // the wave reached the last block
+/// ```
+pub fn run_row(
+    row: &DominoRow,
+    engine: Engine,
+    precision: Precision,
+    solver: SolverSpec,
+    max_time: f64,
+    progress: impl FnMut(usize),
+) -> anyhow::Result<ChainReport> {
+    match precision {
+        Precision::F64 => {
+            crate::rapier::f64::chain::run_row(row, engine, solver, max_time, progress)
+        }
+        Precision::F32 => {
+            crate::rapier::f32::chain::run_row(row, engine, solver, max_time, progress)
+        }
+    }
+}
