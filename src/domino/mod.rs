@@ -9,6 +9,7 @@
 //! | --- | --- |
 //! | [`Block`] | height, thickness, mass, inertia, corners in the body frame |
 //! | [`Preset`], [`RowParams`] | Table 1 of the paper, every value overridable |
+//! | [`Ground`] | the ground under the feet: Coulomb (the paper) or no-slip pivots |
 //! | [`RowSpec`] | a row of `n` blocks at pitch s + d with a push on block 1 |
 //! | [`WaveMeasures`] | t_i, v̂_i (Eq. 33), v̂_na with its spread |
 //! | [`ChainReport`] | the engine-independent JSON report of `topple chain` |
@@ -25,12 +26,14 @@
 //! ```
 
 mod block;
+mod ground;
 mod measures;
 mod preset;
 mod report;
 mod row;
 
 pub use block::Block;
+pub use ground::Ground;
 pub use measures::{Spread, WaveMeasures, FIRST_STEADY_BLOCK};
 pub use preset::{Preset, RowParams};
 pub use report::{BlockSeries, ChainReport, EnergyReport};

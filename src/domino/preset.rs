@@ -2,7 +2,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use super::Block;
+use super::{Block, Ground};
 
 /// The three block types of Table 1.
 ///
@@ -45,6 +45,7 @@ impl Preset {
             alpha: 1.5,
             impact_friction_factor: 0.5,
             gravity: 9.81,
+            ground: Ground::Coulomb,
         }
     }
 }
@@ -83,6 +84,10 @@ pub struct RowParams {
     pub impact_friction_factor: f64,
     /// Gravity g (m/s²).
     pub gravity: f64,
+    /// The ground model: the paper's Coulomb friction (default) or pivots
+    /// that never slip. Absent in older files means Coulomb.
+    #[serde(default)]
+    pub ground: Ground,
 }
 
 impl RowParams {
