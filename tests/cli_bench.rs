@@ -100,7 +100,8 @@ fn table_errors_are_against_the_baseline_and_saved_runs_are_reused() {
 fn bad_runs_and_baselines_are_refused_with_one_line() {
     let dir = std::env::temp_dir().join(format!("topple-cli-bench-bad-{}", std::process::id()));
     for (runs, extra) in [
-        ("rapier:1e-3", &[][..]),
+        ("rapier:1e-3:f16", &[][..]),
+        ("rapier:fast", &[][..]),
         ("native:0", &[][..]),
         ("reference:fast", &[][..]),
         ("reference:paper", &["--baseline", "native:1e-3"][..]),

@@ -86,9 +86,12 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         );
     }
     if let Some(row) = &out.row {
-        match (row.natural_speed, row.natural_speed_spread) {
-            (Some(v), Some(sd)) => println!("natural speed v_na = {v:.4} (spread {sd:.4})"),
-            _ => println!("natural speed: the wave did not reach the end of the row"),
+        match row.natural_speed_spread {
+            Some(s) => println!(
+                "natural speed v_na = {:.4} (std dev {:.4} over {} blocks)",
+                s.mean, s.std_dev, s.count
+            ),
+            None => println!("natural speed: the wave did not get past block 7"),
         }
         println!(
             "blocks hit: {} of {}",

@@ -23,6 +23,20 @@ pub enum Preset {
     P,
 }
 
+impl std::str::FromStr for Preset {
+    type Err = String;
+
+    /// "X", "T" or "P" (either case).
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        match s.to_ascii_uppercase().as_str() {
+            "X" => Ok(Preset::X),
+            "T" => Ok(Preset::T),
+            "P" => Ok(Preset::P),
+            _ => Err(format!("unknown domino preset {s:?} (X, T or P)")),
+        }
+    }
+}
+
 impl Preset {
     /// The Table 1 values of this preset.
     pub fn params(self) -> RowParams {

@@ -1,5 +1,6 @@
 //! From a [`Scene`] to a Rapier world with topple (or its native twin).
 
+use crate::domino::RowSpec as DominoRow;
 use std::collections::HashMap;
 
 use anyhow::{bail, Context};
@@ -12,7 +13,7 @@ use super::backend::prelude::{
 use super::ToppleRapier;
 use crate::coupling::ImpactReport;
 use crate::rapier::scene::{
-    expand_row, pair_material, topple_settings, Engine, PairLaw, Preset, Scene, ShapeKind,
+    expand_row, pair_material, topple_settings, Engine, PairLaw, Scene, ShapeKind,
 };
 
 /// A vector of this build from f64 components.
@@ -23,10 +24,8 @@ fn vector(v: [f64; 2]) -> Vector {
 /// A row's geometry, kept for the wave measures.
 #[derive(Clone, Debug)]
 pub struct RowInfo {
-    /// The preset used.
-    pub preset: Preset,
-    /// Gap between faces s (m).
-    pub spacing: f64,
+    /// The row as the domino layer sees it (parameters, spacing, n, push).
+    pub spec: DominoRow,
     /// The blocks' colliders, in row order.
     pub colliders: Vec<ColliderHandle>,
 }
@@ -71,9 +70,10 @@ pub fn build(scene: &Scene, engine: Engine) -> anyhow::Result<SceneWorld> {
         None => None,
     };
     let s = &scene.solver;
-    let length_unit = s
-        .length_unit
-        .unwrap_or(row.as_ref().map_or(1.0, |(preset, _)| preset.height));
+    let length_unit = s.length_unit.unwrap_or(
+        row.as_ref()
+            .map_or(1.0, |(spec, _)| spec.params.block.height),
+    );
     if !(s.dt > 0.0 && length_unit > 0.0 && scene.duration >= 0.0) {
         bail!("dt and length_unit must be > 0 and duration >= 0");
     }
@@ -181,9 +181,8 @@ pub fn build(scene: &Scene, engine: Engine) -> anyhow::Result<SceneWorld> {
         topple.manage(&mut world.colliders, c, m);
         bodies.push((name, h, c));
     }
-    let row = row.map(|(preset, r)| RowInfo {
-        preset,
-        spacing: r.spacing * preset.height,
+    let row = row.map(|(spec, _)| RowInfo {
+        spec,
         colliders: bodies.iter().map(|b| b.2).collect(),
     });
     Ok(SceneWorld {

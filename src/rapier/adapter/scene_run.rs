@@ -2,12 +2,11 @@
 
 use super::backend::parry::query;
 use super::backend::prelude::{ColliderHandle, ColliderSet, RigidBodySet};
+use crate::domino::ChainReport;
 
 use super::scene_build::{build, SceneWorld};
 use crate::coupling::Resolution;
-use crate::rapier::scene::{
-    BodyState, Engine, RowMeasures, RunOptions, Scene, SceneOutput, TimedImpact,
-};
+use crate::rapier::scene::{BodyState, Engine, RunOptions, Scene, SceneOutput, TimedImpact};
 
 /// The group solved last by topple in the `topple impact` input format.
 pub fn impact_input_json(sw: &SceneWorld) -> serde_json::Value {
@@ -198,15 +197,9 @@ pub fn run_scene(
         }
     }
     let row = sw.row.as_ref().map(|r| {
-        let g = scene.gravity[0].hypot(scene.gravity[1]);
-        RowMeasures::from_hit_times(
-            hits.hit_times.clone(),
-            r.colliders.len(),
-            r.spacing,
-            r.preset.thickness,
-            r.preset.height,
-            g,
-        )
+        let mut report = ChainReport::new(engine.name(), &r.spec, hits.hit_times.clone());
+        report.simulated_time = sw.time;
+        report
     });
     let bodies = sw
         .bodies

@@ -264,6 +264,11 @@ pub struct RowSpec {
     /// Block mass (kg); overrides density.
     #[serde(default)]
     pub mass: Option<f64>,
+    /// The ground under the feet: `"coulomb"` (the paper's friction μ₂,
+    /// default) or `"no-slip"` (pivots never slide; the cooperative model's
+    /// assumption).
+    #[serde(default)]
+    pub ground: crate::domino::Ground,
     /// Overrides of the preset (applied after `ideal`).
     #[serde(default, flatten)]
     pub overrides: RowOverrides,

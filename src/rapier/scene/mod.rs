@@ -6,7 +6,7 @@
 //! | item | file | role |
 //! | --- | --- | --- |
 //! | [`Scene`] and its parts | `format.rs` | the TOML format (serde) |
-//! | [`expand_row`], [`preset`], [`RowMeasures`] | `row.rs` | the domino-row generator and its wave measures |
+//! | [`expand_row`], [`row_params`] | `row.rs` | the `[row]` generator over [`crate::domino`]'s presets and ground models |
 //! | [`Engine`], [`run_scene`], [`run_row`], [`SceneOutput`] | `setup.rs` | build-independent front: settings, materials, output, dispatch to [`crate::rapier::f64`] or [`crate::rapier::f32`] |
 
 mod format;
@@ -17,7 +17,7 @@ pub use format::{
     BodySpec, GroundSpec, MaterialSpec, PairLaw, PairSpec, RowOverrides, RowSpec, Scene, ShapeKind,
     SolverSpec,
 };
-pub use row::{expand_row, preset, Preset, RowMeasures};
+pub use row::{expand_row, row_params, NO_SLIP_FRICTION};
 pub(crate) use setup::pair_material;
 pub use setup::{
     load_scene, row_scene, run_row, run_scene, topple_settings, BodyState, Engine, RunOptions,

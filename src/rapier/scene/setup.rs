@@ -8,7 +8,6 @@ use crate::impact::{ContactMaterial, ImpactSettings};
 use crate::rapier::{Precision, ToppleStats};
 
 use super::format::{PairLaw, RowOverrides, RowSpec as SceneRow, Scene, SolverSpec};
-use super::row::RowMeasures;
 use crate::domino::{ChainReport, RowSpec as DominoRow};
 
 /// Who resolves impacts.
@@ -120,8 +119,9 @@ pub struct SceneOutput {
     pub impacts: Vec<TimedImpact>,
     /// topple's counters.
     pub stats: ToppleStats,
-    /// Wave measures, for a scene with a row.
-    pub row: Option<RowMeasures>,
+    /// For a scene with a row: the same report as `topple chain` (hit
+    /// times, v̂_i, v̂_na and its spread).
+    pub row: Option<ChainReport>,
 }
 
 /// Options of [`run_scene`].
@@ -209,6 +209,7 @@ pub fn row_scene(row: &DominoRow, solver: SolverSpec, max_time: f64) -> Scene {
             ideal: false,
             density: 1000.0,
             mass: Some(p.block.mass),
+            ground: p.ground,
             overrides: RowOverrides {
                 height: Some(p.block.height),
                 thickness: Some(p.block.thickness),
