@@ -13,33 +13,42 @@
 
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::cell::Cell;
-use std::sync::atomic::{AtomicUsize, Ordering};
 
 use topple::rapier::f64::{build, SceneWorld};
 use topple::rapier::scene::{load_scene, Engine};
 
 struct Counting;
 
-static ALLOCATIONS: AtomicUsize = AtomicUsize::new(0);
-/// Allocations made inside Rapier's `RigidBodySet` (its modified list), told
-/// apart by a backtrace when `ATTRIBUTE` is on.
-static RAPIER_ALLOCATIONS: AtomicUsize = AtomicUsize::new(0);
 thread_local! {
     static COUNTING: Cell<bool> = const { Cell::new(false) };
     static ATTRIBUTE: Cell<bool> = const { Cell::new(false) };
+    /// Allocations counted on this thread (per thread, so that tests running
+    /// in parallel do not see each other's).
+    static ALLOCATIONS: Cell<usize> = const { Cell::new(0) };
+    /// Of those, the ones made inside Rapier's `RigidBodySet` (its modified
+    /// list), told apart by a backtrace when `ATTRIBUTE` is on.
+    static RAPIER_ALLOCATIONS: Cell<usize> = const { Cell::new(0) };
+}
+
+fn allocations() -> usize {
+    ALLOCATIONS.with(|c| c.get())
+}
+
+fn rapier_allocations() -> usize {
+    RAPIER_ALLOCATIONS.with(|c| c.get())
 }
 
 fn count_one() {
     if !COUNTING.with(|c| c.get()) {
         return;
     }
-    ALLOCATIONS.fetch_add(1, Ordering::Relaxed);
+    ALLOCATIONS.with(|c| c.set(c.get() + 1));
     if ATTRIBUTE.with(|c| c.get()) {
         // the backtrace allocates too: stop counting while it is taken
         COUNTING.with(|c| c.set(false));
         let trace = std::backtrace::Backtrace::force_capture().to_string();
         if trace.contains("RigidBodySet") {
-            RAPIER_ALLOCATIONS.fetch_add(1, Ordering::Relaxed);
+            RAPIER_ALLOCATIONS.with(|c| c.set(c.get() + 1));
         }
         COUNTING.with(|c| c.set(true));
     }
@@ -78,7 +87,7 @@ fn growth_allocations(len: usize) -> usize {
 /// One step as `ToppleRapier::step` does it, with topple's part counted.
 /// Returns (impacts, allocations inside `begin_step` and `end_step`).
 fn counted_step(sw: &mut SceneWorld) -> (usize, usize) {
-    let before = ALLOCATIONS.load(Ordering::Relaxed);
+    let before = allocations();
     let w = &mut sw.world;
     COUNTING.with(|c| c.set(true));
     sw.topple.begin_step(&w.islands, &w.bodies);
@@ -93,7 +102,7 @@ fn counted_step(sw: &mut SceneWorld) -> (usize, usize) {
         &w.integration_parameters,
     );
     COUNTING.with(|c| c.set(false));
-    (impacts, ALLOCATIONS.load(Ordering::Relaxed) - before)
+    (impacts, allocations() - before)
 }
 
 fn scene(name: &str) -> topple::rapier::scene::Scene {
@@ -125,7 +134,7 @@ fn a_domino_wave_allocates_nothing_once_its_buffers_have_grown() {
     sw.topple = warm.topple;
     let (mut impacts, mut allocations, mut rapier_share) = (0, 0, 0);
     ATTRIBUTE.with(|c| c.set(true));
-    let rapier_before = RAPIER_ALLOCATIONS.load(Ordering::Relaxed);
+    let rapier_before = rapier_allocations();
     for _ in 0..steps {
         let (n, a) = counted_step(&mut sw);
         // at most every body of every group had its velocity written
@@ -135,7 +144,7 @@ fn a_domino_wave_allocates_nothing_once_its_buffers_have_grown() {
         rapier_share += growth_allocations(written);
     }
     ATTRIBUTE.with(|c| c.set(false));
-    let in_rapier = RAPIER_ALLOCATIONS.load(Ordering::Relaxed) - rapier_before;
+    let in_rapier = rapier_allocations() - rapier_before;
     println!(
         "first run: {} impacts, {} allocations; second run: {impacts} impacts, \
          {allocations} allocations, {in_rapier} of them in Rapier's RigidBodySet \

@@ -93,7 +93,8 @@ pub enum HookMode {
 /// assert_eq!(Precision::default(), Precision::F64);
 /// assert_eq!(Precision::F32.name(), "f32");
 /// ```
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize, clap::ValueEnum)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
 #[serde(rename_all = "lowercase")]
 pub enum Precision {
     /// `rapier2d` (f32), the build `bevy_rapier2d` uses.

@@ -53,4 +53,6 @@ mod stepper;
 
 pub use engine::{run, run_with_progress, EngineError, RunResult, Snapshot};
 pub use settings::{Integrator, Settings};
-pub use snapshot::{snapshot_png, snapshot_svg, PNG_BLOCK};
+#[cfg(feature = "plots")]
+pub use snapshot::snapshot_png;
+pub use snapshot::{snapshot_svg, PNG_BLOCK};

@@ -61,7 +61,9 @@ const MM: f64 = 1000.0;
 
 /// Fill of a block in the PNG (the SVG's colour), its outline and the ground.
 pub const PNG_BLOCK: [u8; 3] = [0xd9, 0xa4, 0x41];
+#[cfg(feature = "plots")]
 const PNG_INK: [u8; 3] = [0, 0, 0];
+#[cfg(feature = "plots")]
 const PNG_PAPER: [u8; 3] = [0xff, 0xff, 0xff];
 
 /// The drawing's frame, in mm: snapshots stacked top to bottom, each row
@@ -113,7 +115,7 @@ impl Layout {
     }
 }
 
-/// A PNG drawing of the same snapshots as [`snapshot_svg`] (same layout,
+/// A PNG drawing (feature `plots`) of the same snapshots as [`snapshot_svg`] (same layout,
 /// without the time labels: there is no font rasteriser here), at
 /// `px_per_mm` pixels per millimetre of the drawing (4 matches the SVG's
 /// nominal size; the width is capped at 16,384 px). Blocks are filled with
@@ -127,6 +129,7 @@ impl Layout {
 /// let png = snapshot_png(&Block::new(0.08, 0.01), &[s], 0, 1, 4.0).unwrap();
 /// assert_eq!(&png[1..4], b"PNG");
 /// ```
+#[cfg(feature = "plots")]
 pub fn snapshot_png(
     block: &Block,
     snaps: &[Snapshot],
@@ -166,6 +169,7 @@ pub fn snapshot_png(
     Ok(out)
 }
 
+#[cfg(feature = "plots")]
 /// An RGB raster, row by row from the top.
 struct Canvas {
     w: usize,
@@ -173,6 +177,7 @@ struct Canvas {
     rgb: Vec<u8>,
 }
 
+#[cfg(feature = "plots")]
 impl Canvas {
     fn put(&mut self, x: i64, y: i64, colour: [u8; 3]) {
         if x >= 0 && y >= 0 && (x as usize) < self.w && (y as usize) < self.h {

@@ -14,7 +14,7 @@
 //! | `single.rs` | the single collision model (μ, e): derivation and solution |
 //! | `threshold.rs` | [`min_spacing`]: the smallest spacing with a wave, bracketed |
 //! | `sweep.rs` | [`sweep`] over s/h and the CSV table |
-//! | `plot.rs` | [`plot_svg`]: the Fig. 5 theory lines as SVG |
+//! | `plot.rs` | `plot_svg`: the Fig. 5 theory lines as SVG (feature `plots`) |
 //! | `outcome.rs` | [`Wave`], [`NoWave`], [`Outcome`], [`TheoryError`] |
 //!
 //! Units: lengths over the block height h, speeds over √(gh), angular
@@ -61,6 +61,7 @@ mod cooperative;
 mod geometry;
 mod outcome;
 mod period;
+#[cfg(feature = "plots")]
 mod plot;
 mod single;
 mod sweep;
@@ -69,6 +70,7 @@ mod train;
 
 pub use geometry::Geometry;
 pub use outcome::{NoWave, Outcome, TheoryError, Wave};
+#[cfg(feature = "plots")]
 pub use plot::plot_svg;
 pub use sweep::{sweep, write_csv, SweepRow};
 pub use threshold::{min_spacing, SpacingBracket};

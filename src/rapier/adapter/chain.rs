@@ -4,7 +4,7 @@
 use std::time::Instant;
 
 use crate::domino::{ChainReport, RowSpec};
-use crate::rapier::scene::{row_scene, Engine, SolverSpec};
+use crate::rapier::scene::{row_scene, Engine, SceneResult, SolverSpec};
 
 use super::{build, HitTracker};
 
@@ -19,7 +19,7 @@ pub fn run_row(
     solver: SolverSpec,
     max_time: f64,
     mut progress: impl FnMut(usize),
-) -> anyhow::Result<ChainReport> {
+) -> SceneResult<ChainReport> {
     let scene = row_scene(row, solver, max_time);
     let start = Instant::now();
     let mut sw = build(&scene, engine)?;

@@ -3,8 +3,6 @@
 use crate::domino::RowSpec as DominoRow;
 use std::collections::HashMap;
 
-use anyhow::{bail, Context};
-
 use super::backend::math::Real;
 use super::backend::prelude::{
     ColliderBuilder, ColliderHandle, IntegrationParameters, PhysicsWorld, RigidBodyBuilder,
@@ -13,7 +11,8 @@ use super::backend::prelude::{
 use super::ToppleRapier;
 use crate::coupling::ImpactReport;
 use crate::rapier::scene::{
-    expand_row, pair_material, topple_settings, Engine, PairLaw, Scene, ShapeKind,
+    expand_row, pair_material, topple_settings, Engine, PairLaw, Scene, SceneError, SceneResult,
+    ShapeKind,
 };
 
 /// A vector of this build from f64 components.
@@ -63,7 +62,7 @@ pub struct SceneWorld {
 /// sw.step();
 /// assert!(sw.kinetic_energy() > 0.0); // block 1 is pushed
 /// ```
-pub fn build(scene: &Scene, engine: Engine) -> anyhow::Result<SceneWorld> {
+pub fn build(scene: &Scene, engine: Engine) -> SceneResult<SceneWorld> {
     let mut scene = scene.clone();
     let row = match scene.row.clone() {
         Some(r) => Some((expand_row(&mut scene, &r)?, r)),
@@ -75,10 +74,12 @@ pub fn build(scene: &Scene, engine: Engine) -> anyhow::Result<SceneWorld> {
             .map_or(1.0, |(spec, _)| spec.params.block.height),
     );
     if !(s.dt > 0.0 && length_unit > 0.0 && scene.duration >= 0.0) {
-        bail!("dt and length_unit must be > 0 and duration >= 0");
+        return Err(SceneError::invalid(
+            "dt and length_unit must be > 0 and duration >= 0",
+        ));
     }
     if s.contact_hertz.is_some_and(|f| !(f > 0.0 && f.is_finite())) {
-        bail!("contact_hertz must be > 0 and finite");
+        return Err(SceneError::invalid("contact_hertz must be > 0 and finite"));
     }
     let mut world = PhysicsWorld {
         gravity: vector(scene.gravity),
@@ -114,22 +115,25 @@ pub fn build(scene: &Scene, engine: Engine) -> anyhow::Result<SceneWorld> {
             impact_friction_factor: m.impact_friction_factor,
         };
         if !(0.0..=1.0).contains(&m.restitution) || m.stiffness <= 0.0 || m.friction < 0.0 {
-            bail!(
+            return Err(SceneError::invalid(format!(
                 "material {:?}: need stiffness > 0, restitution in [0, 1], friction >= 0",
                 m.name
-            );
+            )));
         }
         if ids
             .insert(m.name.clone(), topple.add_material(pair_material(&law)))
             .is_some()
         {
-            bail!("material {:?} defined twice", m.name);
+            return Err(SceneError::invalid(format!(
+                "material {:?} defined twice",
+                m.name
+            )));
         }
     }
     let id = |name: &str| {
         ids.get(name)
             .copied()
-            .with_context(|| format!("unknown material {name:?}"))
+            .ok_or_else(|| SceneError::invalid(format!("unknown material {name:?}")))
     };
     for p in &scene.pairs {
         topple.set_pair_material(
@@ -154,13 +158,13 @@ pub fn build(scene: &Scene, engine: Engine) -> anyhow::Result<SceneWorld> {
             ShapeKind::Box => {
                 let [w, h] = b
                     .size
-                    .with_context(|| format!("body {name}: a box needs size"))?;
+                    .ok_or_else(|| SceneError::invalid(format!("body {name}: a box needs size")))?;
                 ColliderBuilder::cuboid((0.5 * w) as Real, (0.5 * h) as Real)
             }
             ShapeKind::Ball => {
-                let r = b
-                    .radius
-                    .with_context(|| format!("body {name}: a ball needs radius"))?;
+                let r = b.radius.ok_or_else(|| {
+                    SceneError::invalid(format!("body {name}: a ball needs radius"))
+                })?;
                 ColliderBuilder::ball(r as Real)
             }
         };

@@ -6,7 +6,9 @@ use crate::domino::ChainReport;
 
 use super::scene_build::{build, SceneWorld};
 use crate::coupling::Resolution;
-use crate::rapier::scene::{BodyState, Engine, RunOptions, Scene, SceneOutput, TimedImpact};
+use crate::rapier::scene::{
+    BodyState, Engine, RunOptions, Scene, SceneError, SceneOutput, SceneResult, TimedImpact,
+};
 
 /// The group solved last by topple in the `topple impact` input format.
 pub fn impact_input_json(sw: &SceneWorld) -> serde_json::Value {
@@ -164,11 +166,7 @@ fn first_impact(sw: &SceneWorld, a: ColliderHandle, b: ColliderHandle) -> Option
 /// assert_eq!(out.impacts.len(), 1);
 /// assert!((out.bodies[1].velocity[0] - 1.0).abs() < 1e-3);
 /// ```
-pub fn run_scene(
-    scene: &Scene,
-    engine: Engine,
-    options: RunOptions,
-) -> anyhow::Result<SceneOutput> {
+pub fn run_scene(scene: &Scene, engine: Engine, options: RunOptions) -> SceneResult<SceneOutput> {
     let mut sw = build(scene, engine)?;
     let dt = f64::from(sw.world.integration_parameters.dt);
     let steps = (scene.duration / dt).round() as usize;
@@ -184,8 +182,12 @@ pub fn run_scene(
         impacts.extend(reports.iter().map(|&report| TimedImpact { time, report }));
         if fallback {
             if let Some(path) = dump.take() {
-                let json = serde_json::to_string_pretty(&impact_input_json(&sw))?;
-                std::fs::write(path, json)?;
+                let json = serde_json::to_string_pretty(&impact_input_json(&sw))
+                    .expect("a JSON value always serialises");
+                std::fs::write(path, json).map_err(|source| SceneError::Io {
+                    path: path.clone(),
+                    source,
+                })?;
             }
         }
         taken += 1;

@@ -4,6 +4,7 @@
 
 use crate::domino::{Ground, Preset, RowParams, RowSpec as DominoRow};
 
+use super::error::{SceneError, SceneResult};
 use super::format::{
     BodySpec, GroundSpec, MaterialSpec, PairLaw, PairSpec, RowSpec, Scene, ShapeKind,
 };
@@ -26,11 +27,11 @@ pub const NO_SLIP_FRICTION: f64 = 1e3;
 /// assert_eq!((p.mu1, p.e1, p.mu2), (0.0, 0.0, 0.9));
 /// assert_eq!(p.block.height, 0.08);
 /// ```
-pub fn row_params(row: &RowSpec, gravity: f64) -> anyhow::Result<RowParams> {
+pub fn row_params(row: &RowSpec, gravity: f64) -> SceneResult<RowParams> {
     let mut p = row
         .preset
         .parse::<Preset>()
-        .map_err(|e| anyhow::anyhow!(e))?
+        .map_err(SceneError::Invalid)?
         .params();
     if row.ideal {
         p = p.ideal();
@@ -68,7 +69,7 @@ pub fn row_params(row: &RowSpec, gravity: f64) -> anyhow::Result<RowParams> {
 /// x = (i − 1)(s + d); block 1 rotates clockwise about its front bottom edge
 /// at θ̇ = push/t̄. A [`Ground::NoSlip`] row gets [`NO_SLIP_FRICTION`] at
 /// the block–ground pair, not halved inside impacts.
-pub fn expand_row(scene: &mut Scene, row: &RowSpec) -> anyhow::Result<DominoRow> {
+pub fn expand_row(scene: &mut Scene, row: &RowSpec) -> SceneResult<DominoRow> {
     let g = scene.gravity[0].hypot(scene.gravity[1]);
     let p = row_params(row, g)?;
     let domino = DominoRow::new(p, row.spacing * p.block.height, row.n, row.push);

@@ -1,8 +1,7 @@
 //! What a scene run needs that does not depend on the Rapier build: the
 //! engine choice, the settings and materials built from a scene, the output.
 
-use anyhow::Context;
-
+use super::error::SceneResult;
 use crate::coupling::{FallbackPolicy, ImpactReport, PairMaterial, PatchRule, ToppleSettings};
 use crate::impact::{ContactMaterial, ImpactSettings};
 use crate::rapier::{Precision, ToppleStats};
@@ -16,7 +15,8 @@ use crate::domino::{ChainReport, RowSpec as DominoRow};
 /// use topple::rapier::scene::Engine;
 /// assert_eq!(Engine::RapierNative.name(), "rapier-native");
 /// ```
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Default, serde::Serialize, clap::ValueEnum)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default, serde::Serialize)]
+#[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
 #[serde(rename_all = "kebab-case")]
 pub enum Engine {
     /// Rapier with topple's LZB impacts and λ-point contact.
@@ -170,7 +170,7 @@ pub fn run_scene(
     engine: Engine,
     precision: Precision,
     options: RunOptions,
-) -> anyhow::Result<SceneOutput> {
+) -> SceneResult<SceneOutput> {
     match precision {
         Precision::F64 => crate::rapier::f64::run_scene(scene, engine, options),
         Precision::F32 => crate::rapier::f32::run_scene(scene, engine, options),
@@ -178,10 +178,16 @@ pub fn run_scene(
 }
 
 /// Reads and parses a scene file.
-pub fn load_scene(path: &std::path::Path) -> anyhow::Result<Scene> {
-    let text =
-        std::fs::read_to_string(path).with_context(|| format!("reading {}", path.display()))?;
-    toml::from_str(&text).with_context(|| format!("parsing {}", path.display()))
+#[cfg(feature = "scene-files")]
+pub fn load_scene(path: &std::path::Path) -> SceneResult<Scene> {
+    let text = std::fs::read_to_string(path).map_err(|source| super::SceneError::Io {
+        path: path.into(),
+        source,
+    })?;
+    toml::from_str(&text).map_err(|e| super::SceneError::Parse {
+        path: path.into(),
+        message: e.to_string(),
+    })
 }
 
 /// The scene of a domino row of [`crate::domino`]: the row's every parameter
@@ -249,7 +255,7 @@ pub fn run_row(
     solver: SolverSpec,
     max_time: f64,
     progress: impl FnMut(usize),
-) -> anyhow::Result<ChainReport> {
+) -> SceneResult<ChainReport> {
     match precision {
         Precision::F64 => {
             crate::rapier::f64::chain::run_row(row, engine, solver, max_time, progress)
