@@ -1,6 +1,6 @@
 //! Run time of the reference engine on short rows (criterion). The
 //! work-precision and 100/1,000/10,000-block tables of the issue are not
-//! produced by this bench yet (see README).
+//! produced by this bench yet.
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use topple::domino::{Preset, RowSpec};

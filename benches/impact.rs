@@ -1,4 +1,4 @@
-//! Work-precision of the LZB resolver (issue 2): run time, steps and error
+//! Work-precision of the LZB resolver: run time, steps and error
 //! against an independent compliant-model ODE, for the paper's fixed impulse
 //! step and for adaptive stepping.
 //!

@@ -32,3 +32,8 @@ pub mod theory;
 
 pub use rapier2d;
 pub use rapier2d_f64;
+
+// The README's code blocks compile and run as doctests, so they cannot go stale.
+#[cfg(doctest)]
+#[doc = include_str!("../README.md")]
+pub struct ReadmeDoctests;

@@ -1,5 +1,5 @@
 //! `topple chain --engine rapier|rapier-native` reports with the reference
-//! engine's JSON keys (issue 5), and bad engine arguments are errors.
+//! engine's JSON keys, and bad engine arguments are errors.
 
 use std::process::Command;
 

@@ -1,5 +1,5 @@
 //! `topple impact`: JSON in, JSON out; bad input exits non-zero with one line
-//! on stderr and nothing on stdout (issue 2).
+//! on stderr and nothing on stdout.
 
 use std::io::Write;
 use std::process::{Command, Stdio};

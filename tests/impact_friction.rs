@@ -1,4 +1,4 @@
-//! Coulomb friction inside the impact (errata §4), against closed forms.
+//! Coulomb friction inside the impact (docs/model.md §4), against closed forms.
 //!
 //! A disk of radius r lands on the ground with velocity (u, −w) and spin ω.
 //! The normal passes through the centre, so the normal and tangential problems

@@ -1,4 +1,4 @@
-//! A group of 20 leaning blocks with ground contacts (issue 2): with e = 1 and
+//! A group of 20 leaning blocks with ground contacts: with e = 1 and
 //! no friction, the resolver against the compliant model integrated in time
 //! with frozen geometry (tests/common/compliant.rs); with the domino's e = 0
 //! and friction, the conservation checks and agreement of the two step
@@ -73,7 +73,7 @@ fn domino_group_dissipates_and_both_step_controls_agree() {
         .solve(&bodies, &contacts, &ImpactSettings::fixed(1e-5))
         .unwrap();
     // Event-heavy (e = 0 and stick/slip): the adaptive mode needs a tight
-    // tolerance here (README, work against precision).
+    // tolerance here (`cargo bench --bench impact` prints the work-precision table).
     let adaptive = ImpactSolver::new()
         .solve(&bodies, &contacts, &ImpactSettings::adaptive(1e-8))
         .unwrap();

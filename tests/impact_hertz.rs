@@ -1,5 +1,5 @@
 //! e = 1, no friction: the LZB resolver against the compliant model F = k δ^α
-//! integrated in time (DESIGN.md "Physics that must hold"; issue 2).
+//! integrated in time (docs/model.md).
 
 mod common;
 use common::hertz::Chain;

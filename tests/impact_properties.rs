@@ -1,4 +1,4 @@
-//! Property tests on random frictional multiple impacts (issue 2):
+//! Property tests on random frictional multiple impacts:
 //! the resolver ends (Ok, or the step-limit error: never a hang or a panic),
 //! kinetic energy never increases, momentum is conserved when every body is
 //! free, and nothing becomes NaN.

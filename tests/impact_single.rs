@@ -1,4 +1,4 @@
-//! One contact: closed forms independent of the resolver (issue 2, DESIGN.md).
+//! One contact: closed forms independent of the resolver.
 //!
 //! For a single frictionless contact the LZB model reduces to a two-body
 //! collision with effective mass m_eff = 1/W (W = J M⁻¹ Jᵀ): the normal

@@ -1,5 +1,4 @@
-//! What topple costs on top of Rapier (issue 5, "skips what the scene does not
-//! need"): sleeping bodies are never queried, and once its buffers have grown
+//! What topple costs on top of Rapier: sleeping bodies are never queried, and once its buffers have grown
 //! to the largest impact group, the impact pass allocates nothing.
 //!
 //! Allocations are counted by a global allocator that counts only while the

@@ -83,7 +83,7 @@ fn box_dropped_flat_rebounds_as_the_resolver_says() {
         .with_velocity([0.0, v_in]);
     let contacts: Vec<Contact> = (0..9)
         .map(|p| {
-            let x = -0.5 * W + W * p as f64 / 8.0; // errata §5: edge to edge
+            let x = -0.5 * W + W * p as f64 / 8.0; // docs/model.md §5: edge to edge
             Contact::new([None, Some(0)], [x, 0.0], [0.0, 1.0], material())
         })
         .collect();

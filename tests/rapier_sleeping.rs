@@ -1,4 +1,4 @@
-//! Sleeping costs nothing and changes nothing (issue 5): a body that Rapier
+//! Sleeping costs nothing and changes nothing: a body that Rapier
 //! has put to sleep and that an awake body strikes takes part in the impact
 //! with its own supports, exactly as if it had been awake.
 //!

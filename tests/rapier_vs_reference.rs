@@ -1,4 +1,4 @@
-//! Domino X with Table 1's parameters (issue 5): the natural speed of the row
+//! Domino X with Table 1's parameters: the natural speed of the row
 //! run through Rapier with topple's impacts against the paper's model (the
 //! reference engine), which shares only the resolver and the presets with it.
 //! Native Rapier's result is printed for the record.

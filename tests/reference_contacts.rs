@@ -33,7 +33,7 @@ fn heel_contacts_keep_sliding_blocks_apart() {
     assert!(a > 0.02 * h, "without heel contacts the overlap is {a} m");
     // With them every contact is held to the engine's gap tolerance; measured
     // 6.7e-5 m. Tolerance 0.5% of h (0.21 mm), the order of the penetration
-    // the paper's fixed step allows at the other contacts (README).
+    // the paper's fixed step allows at the other contacts.
     assert!(b < 0.005 * h, "with heel contacts the overlap is {b} m");
     // the wave still runs the whole row, with Table 1's rebounds
     assert_eq!(with.hit_times.len(), 20);

@@ -5,7 +5,7 @@ use topple::reference::{run, Settings};
 
 /// θ(t) of a block rotating about its front bottom edge without slipping,
 /// integrated here with a small fixed-step RK4:
-/// I_A θ̈ = m g r sin(θ − φ₀) with r = ½√(h² + d²), tan φ₀ = d/h (theory.md, τ_k).
+/// I_A θ̈ = m g r sin(θ − φ₀) with r = ½√(h² + d²), tan φ₀ = d/h (docs/theory.md, τ_k).
 fn pivot_theta(h: f64, d: f64, g: f64, w0: f64, t_end: f64) -> (f64, f64) {
     let r = 0.5 * (h * h + d * d).sqrt();
     let phi0 = (d / h).atan();

@@ -1,7 +1,7 @@
-//! Trends of the reference engine's natural speed (issue 4, items 2 and 5):
+//! Trends of the reference engine's natural speed:
 //! friction between blocks against the extended group model (Fig. 5), and the
 //! parameter studies of Figs. 9 and 10 on Domino X. The natural speed v̂_na is
-//! the mean of v̂_i over blocks 7.. (DESIGN.md); its spread is the standard
+//! the mean of v̂_i over blocks 7..; its spread is the standard
 //! deviation of those v̂_i. Numbers quoted are measured with the paper's
 //! integration (improved Euler, Δt = 10⁻⁴ s), push 1.0.
 
@@ -69,8 +69,8 @@ fn assert_drop(what: &str, hi: (f64, f64), lo: (f64, f64), floor: f64) {
 // The paper: "the extended group model can give a good prediction when domino
 // spacing is not sufficiently large. For a large domino spacing, however, a
 // relative large error exists". The engine does NOT reproduce this: with the
-// paper's settings (impact friction 0.5 × μ1, errata §4) it reads about 5 %
-// above the extended model at every spacing it runs cleanly (README: +6.4 %
+// paper's settings (impact friction 0.5 × μ1, docs/model.md §4) it reads about 5 %
+// above the extended model at every spacing it runs cleanly (+6.4 %
 // at s/h 0.35, +6.8 % at 0.4, +5.6 % at 0.45, +5.2 % at 0.5, +5.0 % at 0.55,
 // 30 blocks; +4.8 % at 0.55 and 0.6 with 20 blocks), and the deviation shrinks
 // rather than grows with s/h. What the engine does, and what these tests hold,
@@ -130,7 +130,7 @@ fn with_full_impact_friction_the_engine_follows_the_extended_model() {
 // rebound motion of dominoes". Each trend must exceed the sum of the two
 // runs' spreads of v̂_i (a conservative margin: v̂_na is a mean of 13 v̂_i).
 // s/h 0.52 is the spacing where the engine runs every value cleanly; at 0.18
-// and 0.35 some runs of `topple paper` hit plastic fallbacks (README).
+// and 0.35 some runs of `topple paper` hit plastic fallbacks.
 // ---------------------------------------------------------------------------
 
 /// Fig. 9a: v̂_na falls as μ1 rises. Measured: μ1 0 → 1.6626 ± 0.0211,

@@ -1,7 +1,7 @@
 //! The reference engine's wave against the independent cooperative-model
 //! oracle (tests/common/cooperative.rs, checked against published values) and
 //! conservation laws. Rows of 30 Domino T blocks; the natural speed is the mean
-//! of v̂_i over blocks 7..29 (DESIGN.md).
+//! of v̂_i over blocks 7..29.
 
 mod common;
 
@@ -161,7 +161,7 @@ fn accurate_and_paper_integrations_agree() {
 // file that uses it, so that it runs once).
 #[test]
 fn oracle_reproduces_the_published_values() {
-    // theory.md: h 48 mm, d 7.5 mm, λ 16 mm: 1.380 m/s (μ = 0), 1.023 m/s (μ = 0.2)
+    // docs/theory.md: h 48 mm, d 7.5 mm, λ 16 mm: 1.380 m/s (μ = 0), 1.023 m/s (μ = 0.2)
     let (h, d, lam) = (0.048, 0.0075, 0.016);
     let vbar = (9.81f64 * h).sqrt();
     let v0 = cooperative_speed(h, d, lam - d, 0.0) * vbar * (9.8f64 / 9.81).sqrt();

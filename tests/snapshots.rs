@@ -1,4 +1,4 @@
-//! Snapshots of the row (issue 4, "snapshots of the row as SVG/PNG"): the
+//! Snapshots of the row: the
 //! PNG drawing is checked against the geometry of hand-placed blocks (where
 //! their centres and the gaps between them fall, and the area they cover),
 //! and `topple chain` writes it and refuses drawing options that would be

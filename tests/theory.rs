@@ -1,4 +1,4 @@
-//! Checks of the theory models (issue 3): known values, limits, monotonicity,
+//! Checks of the theory models: known values, limits, monotonicity,
 //! and derivations written here independently of `src/theory`.
 
 use topple::theory::{min_spacing, solve, Geometry, Model, NoWave, Outcome};
@@ -10,7 +10,7 @@ fn speed(model: Model, d: f64, s: f64) -> f64 {
         .unwrap_or_else(|| panic!("{model:?} has no wave at d/h = {d}, s/h = {s}"))
 }
 
-/// theory.md: h = 48 mm, d = 7.5 mm, λ = 16 mm, g = 9.8 m/s² gives 1.380 m/s at
+/// docs/theory.md: h = 48 mm, d = 7.5 mm, λ = 16 mm, g = 9.8 m/s² gives 1.380 m/s at
 /// μ = 0 and 1.023 m/s at μ = 0.2. The values are printed with 4 digits
 /// (±0.0005 m/s); we allow 0.1 % (about ±0.0014 m/s and ±0.0010 m/s).
 #[test]

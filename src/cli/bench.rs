@@ -62,7 +62,7 @@ pub struct Args {
     /// Reference runs: freeze blocks behind the wave below this speed
     /// (fraction of √(gh)) and acceleration (fraction of g); default 10⁻⁴.
     /// Rows whose blocks keep bouncing behind the wave (Table 1's e1, e2)
-    /// need 10⁻² for a cost linear in the number of blocks (README).
+    /// need 10⁻² for a cost linear in the number of blocks.
     #[arg(long)]
     pub freeze_tolerance: Option<f64>,
     /// Rapier engines: stop after this much simulated time (s).

@@ -135,7 +135,7 @@ pub struct Args {
     pub freeze_tolerance: Option<f64>,
     /// Reference engine: make the heel of every block a contact on the front
     /// face of the block behind (no overlap where blocks slide back; about
-    /// twice the run time, see README).
+    /// twice the run time).
     #[arg(long)]
     pub heel_contacts: bool,
     /// Rapier engines: the Rapier build (f32 is what bevy_rapier2d uses).

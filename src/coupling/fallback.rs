@@ -1,6 +1,6 @@
 //! The policy for an impact the LZB law cannot finish, shared by every engine.
 //!
-//! An impact is first solved with the paper's law (errata §2: an e = 0 contact
+//! An impact is first solved with the paper's law (docs/model.md §2: an e = 0 contact
 //! releases its energy when its compression ends and loads again from zero if
 //! it is still pushed). A group that stays wedged — blocks pressed between
 //! their neighbours and the ground — goes through ever smaller release and

@@ -1,4 +1,4 @@
-//! λ-point line contact (paper Sec. 2.1, Eq. 10 as corrected in errata §5),
+//! λ-point line contact (paper Sec. 2.1, Eq. 10 as corrected in docs/model.md §5),
 //! engine-agnostic.
 //!
 //! A collision library describes a flat face resting on a flat face by a

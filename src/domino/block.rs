@@ -11,7 +11,7 @@ use serde::{Deserialize, Serialize};
 /// ```
 /// use topple::domino::Block;
 /// let b = Block::new(0.08, 0.0096);
-/// // I = m (h² + d²) / 12 about the centre of mass (errata §6)
+/// // I = m (h² + d²) / 12 about the centre of mass (docs/model.md §6)
 /// assert!((b.inertia() - (0.08f64.powi(2) + 0.0096f64.powi(2)) / 12.0).abs() < 1e-15);
 /// assert_eq!(b.front_bottom(), [0.0048, -0.04]);
 /// ```
@@ -66,7 +66,7 @@ impl Block {
     }
 
     /// The `p`-th of `lambda` equidistant points on the bottom face, p = 0..λ−1,
-    /// from the back edge to the front edge (errata §5: x_p = p/(λ−1)·d − d/2).
+    /// from the back edge to the front edge (docs/model.md §5: x_p = p/(λ−1)·d − d/2).
     pub fn bottom_point(&self, p: usize, lambda: usize) -> [f64; 2] {
         let f = if lambda > 1 {
             p as f64 / (lambda - 1) as f64

@@ -1,4 +1,4 @@
-//! The wave-speed measures of the paper (Sec. 3.1, Eq. 33) and DESIGN.md.
+//! The wave-speed measures of the paper (Sec. 3.1, Eq. 33); their definitions are in docs/model.md, "Measures of the wave".
 
 use serde::{Deserialize, Serialize};
 

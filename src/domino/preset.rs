@@ -88,12 +88,12 @@ pub struct RowParams {
     /// Contact stiffness with the ground k2 (N/m^α).
     pub k2: f64,
     /// Number λ of points replacing the line contact under a standing block
-    /// (errata §5; the paper uses 9).
+    /// (docs/model.md §5; the paper uses 9).
     pub lambda_points: usize,
     /// Exponent α of the contact law F = k(−δ)^α (the paper uses 1.5).
     pub alpha: f64,
     /// Factor on the sliding friction coefficients μ1, μ2 inside impacts
-    /// (Table 1 footnote, errata §4: 0.5); the sticking coefficients are not
+    /// (Table 1 footnote, docs/model.md §4: 0.5); the sticking coefficients are not
     /// scaled.
     pub impact_friction_factor: f64,
     /// Gravity g (m/s²).

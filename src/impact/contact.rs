@@ -57,7 +57,7 @@ impl ContactMaterial {
         self
     }
 
-    /// Contact force as a function of stored energy (errata §1, the corrected
+    /// Contact force as a function of stored energy (docs/model.md §1, the corrected
     /// paper Eq. 26): F(E) = (α+1)^(α/(α+1)) k^(1/(α+1)) E^(α/(α+1)).
     #[inline]
     pub fn force_from_energy(&self, stored_energy: f64) -> f64 {

@@ -8,7 +8,7 @@
 //! | [`ImpactSolver`] | reusable solver (keeps its buffers between impacts) |
 //! | [`ImpactOutcome`] | velocities, impulses, peak energies, kinetic energy before/after, steps |
 //!
-//! The model (paper Sec. 2.3 with the corrections of `errata.md` §1–4):
+//! The model (paper Sec. 2.3 with the corrections of docs/model.md §1–4):
 //! positions are frozen and non-impulsive forces ignored during the impact; the
 //! state is advanced in the normal impulse of a *primary* contact; every loaded
 //! contact takes the increment dP_i = dP_p · F_i(E_i)/F_p(E_p) with

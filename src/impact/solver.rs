@@ -6,15 +6,15 @@
 //! Delassus operator W = J M⁻¹ Jᵀ is never formed: W·dP is obtained by applying
 //! dP to the body velocities and reading the contact rates back.
 //!
-//! One impulse step (errata §2–4), an improved-Euler step in the primary's
+//! One impulse step (docs/model.md §2–4), an improved-Euler step in the primary's
 //! impulse: a half step with the start energies predicts the mid-step
 //! energies, by whose ratios the full step is distributed:
 //! 1. normal rates δ̇_i at the start of the step;
 //! 2. the primary p: the contact with the largest stored energy E, or, when no
 //!    contact holds energy, the one approaching fastest;
-//! 3. increments: loaded contacts dP_i = h F_i(E_i)/F_p(E_p) (errata §1);
+//! 3. increments: loaded contacts dP_i = h F_i(E_i)/F_p(E_p) (docs/model.md §1);
 //!    closed contacts with E_i = 0 that approach join with the increment that
-//!    stores E_i ≈ |δ̇_i| dP_i consistently with F_p (errata §3); the step is
+//!    stores E_i ≈ |δ̇_i| dP_i consistently with F_p (docs/model.md §3); the step is
 //!    scaled so that no contact takes more than h;
 //! 4. held contacts and Coulomb friction on the whole step, by projected
 //!    Gauss–Seidel: a contact without slip stays stuck if that needs
@@ -691,11 +691,11 @@ impl ImpactSolver {
     }
 
     /// Steps 1–2: the rates δ̇_i at the start of the step (an e = 0 contact
-    /// whose compression has ended loses its energy, errata §2) and the
+    /// whose compression has ended loses its energy, docs/model.md §2) and the
     /// primary contact: the one with the largest stored energy (in the
     /// corrector, the largest mid-step energy), or, when none holds energy,
     /// the one approaching fastest, whose force is then that of the energy
-    /// |δ̇| h it stores over the step (errata §3). Flies freely to the first
+    /// |δ̇| h it stores over the step (docs/model.md §3). Flies freely to the first
     /// closing gap when only gaps approach; `None` when nothing approaches.
     fn primary(&mut self, h: f64, stage: Stage) -> Option<Primary> {
         let threshold = self.scales.threshold;
@@ -711,7 +711,7 @@ impl ImpactSolver {
             let rate = Self::normal_rate(row, &self.velocity);
             self.rate[i] = rate;
             let s = &mut self.state[i];
-            // e = 0: the energy is lost when compression ends (errata §2).
+            // e = 0: the energy is lost when compression ends (docs/model.md §2).
             // With `e0_hold`, a contact that does not separate then is held
             // closed (a plastic unilateral constraint, see ImpactSettings).
             if row.restitution == 0.0 && s.energy > 0.0 && rate >= -threshold {
@@ -739,7 +739,7 @@ impl ImpactSolver {
         let start_force = if primary != usize::MAX {
             self.rows[primary].force(largest_energy)
         } else {
-            // the primary starts too: its force at the step's end (errata
+            // the primary starts too: its force at the step's end (docs/model.md
             // §3), or, in the adaptive step, its mean over the step (see
             // `increment_of`)
             let row = &self.rows[fastest];
@@ -1207,9 +1207,9 @@ impl ImpactSolver {
 
     /// Normal increment of one contact for a step of primary impulse `h`
     /// (N·s) whose primary pushes with `primary_force` (N): loaded contacts
-    /// in the ratio F_i(E_i)/F_p (errata §1, E_i = `ratio_energy`);
+    /// in the ratio F_i(E_i)/F_p (docs/model.md §1, E_i = `ratio_energy`);
     /// approaching closed contacts without energy start as in the contact
-    /// law, E_i ≈ |δ̇_i| dP_i. The fixed step uses errata §3,
+    /// law, E_i ≈ |δ̇_i| dP_i. The fixed step uses docs/model.md §3,
     /// dP_i = (h c_i / F_p)^(α+1) |δ̇_i|^α, which takes the force at the
     /// step's end; the adaptive step, whose first steps can be long, the
     /// exact start at constant δ̇_i over the step's time h / F_p (F = k w^α

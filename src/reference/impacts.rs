@@ -1,7 +1,7 @@
 //! Impacts (paper Sec. 2.3): a closed contact approaching faster than the
 //! velocity tolerance starts an impact of every body linked to it by closed
 //! contacts; the group goes to the LZB resolver [`crate::impact`] with the
-//! impact friction at `impact_friction_factor` × Table 1 (errata §4). A frozen
+//! impact friction at `impact_friction_factor` × Table 1 (docs/model.md §4). A frozen
 //! block struck by an approaching contact joins the moving set; frozen blocks
 //! merely touching the group take no part in the impact (an approximation: the
 //! tail at rest behind the wave would take a vanishing share of the impulse; if
@@ -83,7 +83,7 @@ impl Engine {
             exponent: p.alpha,
             restitution: e,
             // Only the sliding coefficient is scaled (Table 1's footnote:
-            // "the coefficient of sliding friction in impact"; errata §4);
+            // "the coefficient of sliding friction in impact"; docs/model.md §4);
             // a contact stuck at the start of an impulse step stays stuck
             // while that needs |dP_t| ≤ μ_s dP_n with the table's μ_s.
             friction: f * mu,

@@ -5,10 +5,10 @@
 //! paper's θ being clockwise). Contacts are corners against faces
 //! ([`geometry`](self)): the λ points of the bottom face on the ground (the
 //! paper's A_i is the front one; all λ carry the line contact of a standing
-//! block, errata §5), the front top corner on the ground (a block lying on its
+//! block, docs/model.md §5), the front top corner on the ground (a block lying on its
 //! face), the front top corner B_i on the next block's back face, and, for the
 //! last pair only, the last block's heel on the front face of the one behind
-//! (inside the row that pair is not a contact: a known gap, see the README).
+//! (inside the row that pair is not a contact unless `heel_contacts` is set).
 //!
 //! - Smooth phase (Eqs. 17–20): unilateral contacts with Coulomb friction, the
 //!   mode (pressing / lifting off, sticking with μ_s / sliding with μ) found by
@@ -20,7 +20,7 @@
 //! - Two integrators ([`Integrator`]): the paper's improved Euler at Δt = 10⁻⁴ s,
 //!   and Dormand–Prince 5(4) with error control.
 //! - Impacts (Sec. 2.3): by [`crate::impact::ImpactSolver`], one group of
-//!   closed contacts at a time, impact friction 0.5 × Table 1 (errata §4); an
+//!   closed contacts at a time, impact friction 0.5 × Table 1 (docs/model.md §4); an
 //!   impact the resolver cannot finish within its step limit is solved again
 //!   with its e = 0 contacts held closed (`held_impacts`), and if that fails
 //!   too, as a plastic impact (`impact_fallbacks`).

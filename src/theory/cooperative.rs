@@ -1,6 +1,6 @@
 //! The group models: cooperative (μ = 0, Stronge & Shu 1988, van Leeuwen 2010)
 //! and extended (friction μ between blocks, van Leeuwen 2010; Fujii et al.).
-//! One implementation with μ as a parameter; formulas from theory.md,
+//! One implementation with μ as a parameter; formulas from docs/theory.md,
 //! "Cooperative group" (train sums in [`super::train`]).
 //!
 //! ## Between collisions

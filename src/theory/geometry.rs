@@ -1,10 +1,10 @@
-//! Block and row geometry in units of the block height `h` (theory.md,
+//! Block and row geometry in units of the block height `h` (docs/theory.md,
 //! "Notation" and "Cooperative group": the leaning-pair relation, θ_c, θ_∞).
 //!
 //! Every length here is divided by `h`; angles are in radians, measured from
 //! the vertical, positive when a block leans forward (towards the blocks not yet
 //! hit). Mass and gravity are set to 1 (the motion of a row of identical blocks
-//! does not depend on the mass, errata.md §6), so a torque is in units of
+//! does not depend on the mass, docs/model.md §6), so a torque is in units of
 //! `m g h` and an angular velocity in units of √(g/h).
 
 use super::TheoryError;
@@ -64,13 +64,13 @@ impl Geometry {
     }
 
     /// Collision angle θ_c (rad): the falling block's top front edge meets the
-    /// back face of the next upright block, `sin θ_c = s/h` (theory.md).
+    /// back face of the next upright block, `sin θ_c = s/h` (docs/theory.md).
     /// `None` when `s ≥ h`: the block lands without touching the next one.
     pub fn collision_angle(&self) -> Option<f64> {
         (self.s < 1.0).then(|| self.s.asin())
     }
 
-    /// Rest angle θ_∞ (rad) of the fallen train, `cos θ_∞ = d/λ` (theory.md):
+    /// Rest angle θ_∞ (rad) of the fallen train, `cos θ_∞ = d/λ` (docs/theory.md):
     /// the fixed point of [`Geometry::lean_behind`].
     pub fn rest_angle(&self) -> f64 {
         (self.d / self.pitch()).acos()
@@ -78,7 +78,7 @@ impl Geometry {
 
     /// Angle of the block leaning on the back face of a block at angle
     /// `theta_front` (rad), from the leaning-pair relation
-    /// `h sin(θ_{k+1} − θ_k) = λ cos θ_k − d` (theory.md, "Cooperative group").
+    /// `h sin(θ_{k+1} − θ_k) = λ cos θ_k − d` (docs/theory.md, "Cooperative group").
     /// Valid while `|λ cos θ_k − d| ≤ h`, which holds for `0 ≤ θ_k ≤ θ_∞` and `s < h`.
     pub fn lean_behind(&self, theta_front: f64) -> f64 {
         theta_front + (self.pitch() * theta_front.cos() - self.d).asin()
@@ -97,13 +97,13 @@ impl Geometry {
     }
 
     /// Moment of inertia about the pivot edge, `I = m (h² + d²)/3`, over `m h²`
-    /// (theory.md, "Notation").
+    /// (docs/theory.md, "Notation").
     pub fn pivot_inertia(&self) -> f64 {
         (1.0 + self.d * self.d) / 3.0
     }
 
     /// Gravity torque about the pivot edge, `m g (√(h²+d²)/2) sin(θ − φ)`, over
-    /// `m g h` (theory.md, τ_k).
+    /// `m g h` (docs/theory.md, τ_k).
     pub fn gravity_torque(&self, theta: f64) -> f64 {
         self.pivot_to_centre() * (theta - self.tip_angle()).sin()
     }

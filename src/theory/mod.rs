@@ -1,7 +1,7 @@
 //! Closed-form and iterative models of the domino wave's natural speed, the
 //! lines the paper compares its simulations with (Sec. 3.2, Fig. 5). Formulas
-//! from `reference/theory.md` (section names cited in each file); the single
-//! collision model, which theory.md gives only in words, is derived in
+//! from docs/theory.md (section names cited in each file); the single
+//! collision model, which docs/theory.md gives only in words, is derived in
 //! `single.rs` and summarised below.
 //!
 //! | file | concept |
@@ -53,7 +53,7 @@
 //! let (h, d, lambda, g) = (0.048, 0.0075, 0.016, 9.8);
 //! let geom = Geometry::new(d / h, (lambda - d) / h).unwrap();
 //! let v = solve(&Model::Cooperative, &geom).unwrap().natural_speed().unwrap() * (g * h).sqrt();
-//! assert!((v - 1.380).abs() < 0.005); // m/s, theory.md
+//! assert!((v - 1.380).abs() < 0.005); // m/s, docs/theory.md
 //! ```
 
 mod chebyshev;

@@ -1,5 +1,5 @@
 //! The single collision model (Stronge 1987; paper Sec. 3.2, dot-dash line of
-//! Fig. 5): only the two blocks of each collision count. theory.md states it in
+//! Fig. 5): only the two blocks of each collision count. docs/theory.md states it in
 //! words; the derivation below is ours.
 //!
 //! ## Geometry of the collision (lengths over h, origin at the striker's pivot)
@@ -23,7 +23,7 @@
 //! Coulomb friction in differential form along the normal impulse:
 //! while A slides down, `dP_t = −μ dP_n`, which gives the lever arms
 //! `I dω_B = (cos θ_c − μ d) dP_n = α dP_n`,
-//! `I dω_A = −(cos θ_c + μ sin θ_c) dP_n = −β dP_n` (the α, β of theory.md at the
+//! `I dω_A = −(cos θ_c + μ sin θ_c) dP_n = −β dP_n` (the α, β of docs/theory.md at the
 //! leading pair). If the slip stops before the impact ends, the contact sticks
 //! (`dP_t/dP_n = κ = cos θ_c (sin θ_c − d)/(sin² θ_c + d²)` keeps `v_t = 0`)
 //! when `|κ| ≤ μ`, otherwise slides up with `dP_t = +μ dP_n`.

@@ -1,4 +1,4 @@
-//! The leaning train behind the leader (theory.md, "Cooperative group"):
+//! The leaning train behind the leader (docs/theory.md, "Cooperative group"):
 //! the sums that the group model's equation of motion and collision law need,
 //! at one leader angle θ_0.
 //!
@@ -18,12 +18,12 @@
 //! block k+1 (normal force at height `cos Δ_k − λ sin θ_k` up block k's back
 //! face, friction `μN` pulling that face down at lever arm `d`); `β_{k+1}` is the
 //! lever arm of the same force about block k+1's pivot. The friction direction
-//! is theory.md's: the rear block's top edge slides down the front block's
+//! is docs/theory.md's: the rear block's top edge slides down the front block's
 //! face. That is what every pair does while the train falls as long as the
 //! far velocity ratio `1 − λ sin θ_∞` is positive; beyond (s/h > 0.886 for
 //! d/h = 0.12) the ratios g_k turn negative and some pairs further back slide
 //! slowly the other way for part of the cycle, which the model (like
-//! theory.md) ignores.
+//! docs/theory.md) ignores.
 //!
 //! The train is summed until a block's terms are below `TRAIN_TOLERANCE` times
 //! the running sums of magnitudes for two blocks in a row. The terms fall off

@@ -1,4 +1,4 @@
-//! The TOML scene format (serde). Units: m, kg, s, rad. See the README
+//! The TOML scene format (serde). Units: m, kg, s, rad. See docs/scenes.md
 //! section "Rapier plugin (`topple scene`)" for a commented example.
 
 use serde::{Deserialize, Serialize};
