@@ -11,7 +11,7 @@
 //! | [`coupling`] | engine-agnostic: materials, λ-point patches, impact groups, the fallback policy |
 //! | [`domino`] | block geometry, Table 1 presets, row builder, wave-speed measures |
 //! | [`theory`] | cooperative, extended and single-collision models of the wave |
-//! | [`reference`] | the paper's reduced-coordinate domino model (the accuracy oracle) |
+//! | [`reference`](mod@reference) | the paper's reduced-coordinate domino model (the accuracy oracle) |
 //! | [`rapier`] | the plugin for Rapier, one source for `rapier2d-f64` and `rapier2d` (f32) |
 //!
 //! Data flows down the table: a module uses the ones above it, never one below.

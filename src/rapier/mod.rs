@@ -1,6 +1,6 @@
 //! The plugin for Rapier: LZB impacts and λ-point contact inside a Rapier
-//! world. One adapter source, compiled for `rapier2d-f64` ([`f64`]) and for
-//! `rapier2d` ([`f32`], what `bevy_rapier2d` uses), as Rapier builds its two
+//! world. One adapter source, compiled for `rapier2d-f64` ([`f64`](mod@f64)) and for
+//! `rapier2d` ([`f32`](mod@f32), what `bevy_rapier2d` uses), as Rapier builds its two
 //! crates from one source.
 //!
 //! | item | role | precision |
