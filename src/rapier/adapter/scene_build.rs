@@ -9,10 +9,10 @@ use super::backend::prelude::{
     RigidBodyHandle, Vector,
 };
 use super::ToppleRapier;
-use crate::coupling::ImpactReport;
+use crate::coupling::{ImpactReport, MaterialId};
 use crate::rapier::scene::{
-    expand_row, pair_material, topple_settings, Engine, PairLaw, Scene, SceneError, SceneResult,
-    ShapeKind,
+    expand_row, pair_material, topple_settings, BodySpec, Engine, PairLaw, Scene, SceneError,
+    SceneResult, ShapeKind,
 };
 
 /// A vector of this build from f64 components.
@@ -65,14 +65,64 @@ pub struct SceneWorld {
 pub fn build(scene: &Scene, engine: Engine) -> SceneResult<SceneWorld> {
     let mut scene = scene.clone();
     let row = match scene.row.clone() {
-        Some(r) => Some((expand_row(&mut scene, &r)?, r)),
+        Some(r) => Some(expand_row(&mut scene, &r)?),
         None => None,
     };
+    let mut world = rapier_world(&scene, row.as_ref())?;
+    let mut topple = match engine {
+        Engine::Rapier => ToppleRapier::new(topple_settings(&scene.solver, scene.gravity)),
+        Engine::RapierNative => ToppleRapier::native(),
+    };
+    let ids = register_materials(&scene, &mut topple)?;
+    let id = |name: &str| {
+        ids.get(name)
+            .copied()
+            .ok_or_else(|| SceneError::invalid(format!("unknown material {name:?}")))
+    };
+    for p in &scene.pairs {
+        topple.set_pair_material(
+            id(&p.materials[0])?,
+            id(&p.materials[1])?,
+            pair_material(&p.law),
+        );
+    }
+    if let Some(g) = &scene.ground {
+        let m = id(&g.material)?;
+        let (_, c) = world.insert(
+            RigidBodyBuilder::fixed().translation(vector([0.0, g.y - 1.0])),
+            ColliderBuilder::cuboid(1.0e3, 1.0),
+        );
+        topple.manage(&mut world.colliders, c, m);
+    }
+    let mut bodies = Vec::with_capacity(scene.bodies.len());
+    for (i, b) in scene.bodies.iter().enumerate() {
+        let name = b.name.clone().unwrap_or_else(|| i.to_string());
+        let (h, c) = world.insert(rigid_body(b), collider(b, &name)?);
+        topple.manage(&mut world.colliders, c, id(&b.material)?);
+        bodies.push((name, h, c));
+    }
+    let row = row.map(|spec| RowInfo {
+        spec,
+        colliders: bodies.iter().map(|b| b.2).collect(),
+    });
+    Ok(SceneWorld {
+        world,
+        topple,
+        bodies,
+        row,
+        engine,
+        time: 0.0,
+    })
+}
+
+/// An empty Rapier world with the scene's gravity and solver settings: the
+/// length unit and contact stiffness default to a row's (its block height,
+/// [`crate::rapier::ROW_CONTACT_HERTZ`]) for a scene with a row.
+fn rapier_world(scene: &Scene, row: Option<&DominoRow>) -> SceneResult<PhysicsWorld> {
     let s = &scene.solver;
-    let length_unit = s.length_unit.unwrap_or(
-        row.as_ref()
-            .map_or(1.0, |(spec, _)| spec.params.block.height),
-    );
+    let length_unit = s
+        .length_unit
+        .unwrap_or(row.map_or(1.0, |spec| spec.params.block.height));
     if !(s.dt > 0.0 && length_unit > 0.0 && scene.duration >= 0.0) {
         return Err(SceneError::invalid(
             "dt and length_unit must be > 0 and duration >= 0",
@@ -94,18 +144,28 @@ pub fn build(scene: &Scene, engine: Engine) -> SceneResult<SceneWorld> {
     };
     let hertz = s
         .contact_hertz
-        .or(row.as_ref().map(|_| crate::rapier::ROW_CONTACT_HERTZ));
+        .or(row.map(|_| crate::rapier::ROW_CONTACT_HERTZ));
     if let Some(f) = hertz {
         let p = &mut world.integration_parameters;
         p.contact_softness.natural_frequency = f as Real;
         p.static_contact_softness.natural_frequency = (2.0 * f) as Real;
     }
-    let mut topple = match engine {
-        Engine::Rapier => ToppleRapier::new(topple_settings(s, scene.gravity)),
-        Engine::RapierNative => ToppleRapier::native(),
-    };
+    Ok(world)
+}
+
+/// Adds the scene's materials to topple; returns their ids by name.
+fn register_materials(
+    scene: &Scene,
+    topple: &mut ToppleRapier,
+) -> SceneResult<HashMap<String, MaterialId>> {
     let mut ids = HashMap::new();
     for m in &scene.materials {
+        if !(0.0..=1.0).contains(&m.restitution) || m.stiffness <= 0.0 || m.friction < 0.0 {
+            return Err(SceneError::invalid(format!(
+                "material {:?}: need stiffness > 0, restitution in [0, 1], friction >= 0",
+                m.name
+            )));
+        }
         let law = PairLaw {
             stiffness: m.stiffness,
             exponent: m.exponent,
@@ -114,12 +174,6 @@ pub fn build(scene: &Scene, engine: Engine) -> SceneResult<SceneWorld> {
             stick_friction: m.stick_friction,
             impact_friction_factor: m.impact_friction_factor,
         };
-        if !(0.0..=1.0).contains(&m.restitution) || m.stiffness <= 0.0 || m.friction < 0.0 {
-            return Err(SceneError::invalid(format!(
-                "material {:?}: need stiffness > 0, restitution in [0, 1], friction >= 0",
-                m.name
-            )));
-        }
         if ids
             .insert(m.name.clone(), topple.add_material(pair_material(&law)))
             .is_some()
@@ -130,72 +184,43 @@ pub fn build(scene: &Scene, engine: Engine) -> SceneResult<SceneWorld> {
             )));
         }
     }
-    let id = |name: &str| {
-        ids.get(name)
-            .copied()
-            .ok_or_else(|| SceneError::invalid(format!("unknown material {name:?}")))
+    Ok(ids)
+}
+
+/// The rigid body of a scene body: fixed or dynamic, at its pose and velocity.
+fn rigid_body(b: &BodySpec) -> RigidBodyBuilder {
+    let builder = if b.fixed {
+        RigidBodyBuilder::fixed()
+    } else {
+        RigidBodyBuilder::dynamic()
     };
-    for p in &scene.pairs {
-        topple.set_pair_material(
-            id(&p.materials[0])?,
-            id(&p.materials[1])?,
-            pair_material(&p.law),
-        );
-    }
-    if let Some(g) = &scene.ground {
-        let m = id(&g.material)?;
-        let (_, c) = world.insert(
-            RigidBodyBuilder::fixed().translation(vector([0.0, g.y - 1.0])),
-            ColliderBuilder::cuboid(1.0e3, 1.0),
-        );
-        topple.manage(&mut world.colliders, c, m);
-    }
-    let mut bodies = Vec::new();
-    for (i, b) in scene.bodies.iter().enumerate() {
-        let name = b.name.clone().unwrap_or_else(|| i.to_string());
-        let m = id(&b.material)?;
-        let mut collider = match b.shape {
-            ShapeKind::Box => {
-                let [w, h] = b
-                    .size
-                    .ok_or_else(|| SceneError::invalid(format!("body {name}: a box needs size")))?;
-                ColliderBuilder::cuboid((0.5 * w) as Real, (0.5 * h) as Real)
-            }
-            ShapeKind::Ball => {
-                let r = b.radius.ok_or_else(|| {
-                    SceneError::invalid(format!("body {name}: a ball needs radius"))
-                })?;
-                ColliderBuilder::ball(r as Real)
-            }
-        };
-        collider = match (b.mass, b.density) {
-            (Some(mass), _) => collider.mass(mass as Real),
-            (None, d) => collider.density(d.unwrap_or(1000.0) as Real),
-        };
-        let body = if b.fixed {
-            RigidBodyBuilder::fixed()
-        } else {
-            RigidBodyBuilder::dynamic()
-        }
+    builder
         .translation(vector(b.position))
         .rotation(b.angle as Real)
         .linvel(vector(b.velocity))
-        .angvel(b.angular_velocity as Real);
-        let (h, c) = world.insert(body, collider);
-        topple.manage(&mut world.colliders, c, m);
-        bodies.push((name, h, c));
-    }
-    let row = row.map(|(spec, _)| RowInfo {
-        spec,
-        colliders: bodies.iter().map(|b| b.2).collect(),
-    });
-    Ok(SceneWorld {
-        world,
-        topple,
-        bodies,
-        row,
-        engine,
-        time: 0.0,
+        .angvel(b.angular_velocity as Real)
+}
+
+/// The collider of a scene body: its shape with its mass or density
+/// (1000 kg/m² by default).
+fn collider(b: &BodySpec, name: &str) -> SceneResult<ColliderBuilder> {
+    let collider = match b.shape {
+        ShapeKind::Box => {
+            let [w, h] = b
+                .size
+                .ok_or_else(|| SceneError::invalid(format!("body {name}: a box needs size")))?;
+            ColliderBuilder::cuboid((0.5 * w) as Real, (0.5 * h) as Real)
+        }
+        ShapeKind::Ball => {
+            let r = b
+                .radius
+                .ok_or_else(|| SceneError::invalid(format!("body {name}: a ball needs radius")))?;
+            ColliderBuilder::ball(r as Real)
+        }
+    };
+    Ok(match (b.mass, b.density) {
+        (Some(mass), _) => collider.mass(mass as Real),
+        (None, d) => collider.density(d.unwrap_or(1000.0) as Real),
     })
 }
 
