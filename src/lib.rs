@@ -7,12 +7,14 @@
 //!
 //! | layer | what it holds |
 //! | --- | --- |
+//! | [`atomic`] | files written whole or not at all (temporary name, then rename) |
 //! | [`impact`] | the LZB resolver: bodies + contacts in, post-impact velocities out |
 //! | [`coupling`] | engine-agnostic: materials, λ-point patches, impact groups, the fallback policy |
 //! | [`domino`] | block geometry, Table 1 presets, row builder, wave-speed measures |
 //! | [`theory`] | cooperative, extended and single-collision models of the wave |
 //! | [`reference`](mod@reference) | the paper's reduced-coordinate domino model (the accuracy oracle) |
 //! | [`rapier`] | the plugin for Rapier, one source for `rapier2d-f64` and `rapier2d` (f32) |
+//! | [`validate`] | input checks at the entry points: field, value and allowed range on one line |
 //!
 //! Data flows down the table: a module uses the ones above it, never one below.
 //! The Rapier crates topple is built against are re-exported, so a user does
@@ -23,12 +25,14 @@
 // two precisions, as Rapier builds rapier2d and rapier2d-f64).
 #![allow(clippy::duplicate_mod)]
 
+pub mod atomic;
 pub mod coupling;
 pub mod domino;
 pub mod impact;
 pub mod rapier;
 pub mod reference;
 pub mod theory;
+pub mod validate;
 
 pub use rapier2d;
 pub use rapier2d_f64;

@@ -63,10 +63,10 @@ pub struct Args {
     /// (fraction of √(gh)) and acceleration (fraction of g); default 10⁻⁴.
     /// Rows whose blocks keep bouncing behind the wave (Table 1's e1, e2)
     /// need 10⁻² for a cost linear in the number of blocks.
-    #[arg(long)]
+    #[arg(long, allow_hyphen_values = true)]
     pub freeze_tolerance: Option<f64>,
     /// Rapier engines: stop after this much simulated time (s).
-    #[arg(long, default_value_t = 600.0)]
+    #[arg(long, allow_hyphen_values = true, default_value_t = 600.0)]
     pub max_time: f64,
     /// Rapier build of the Rapier runs that do not end in `:f32` or `:f64`.
     #[arg(long, value_enum, default_value_t = Precision::F64)]
@@ -262,7 +262,7 @@ fn default_baseline(kinds: &[(String, RunKind)]) -> Option<usize> {
 }
 
 pub fn run(args: Args) -> anyhow::Result<()> {
-    let row = row_spec(&args.row)?;
+    let row = row_spec(&args.row, None)?;
     row.validate()
         .map_err(|e| anyhow::anyhow!("invalid row: {e}"))?;
     let kinds: Vec<(String, RunKind)> = args

@@ -7,6 +7,7 @@ use anyhow::Context;
 
 use topple::domino::{Preset, RowParams, RowSpec};
 use topple::reference::{snapshot_png, snapshot_svg, Integrator, Settings};
+use topple::validate::{self, EngineKind, InputError, Naming, RunBudget};
 
 /// Block type of Table 1.
 #[derive(Clone, Copy, Debug, clap::ValueEnum)]
@@ -49,56 +50,56 @@ pub struct RowArgs {
     #[arg(long, value_enum, ignore_case = true, default_value = "x")]
     pub preset: PresetArg,
     /// Gap over height, s/h.
-    #[arg(long)]
+    #[arg(long, allow_hyphen_values = true)]
     pub spacing_ratio: f64,
     /// Number of blocks.
     #[arg(long, default_value_t = 40)]
     pub n: usize,
     /// Dimensionless initial angular velocity of block 1, θ̇₁ √(h/g).
-    #[arg(long, default_value_t = 1.0)]
+    #[arg(long, allow_hyphen_values = true, default_value_t = 1.0)]
     pub push: f64,
     /// Use the ideal material of Sec. 3.2 (μ1 = 0, e1 = 0, μ2 = 0.9, e2 = 0)
     /// before the overrides below.
     #[arg(long)]
     pub ideal: bool,
     /// Sliding friction between blocks (sets --mu1-stick too unless given).
-    #[arg(long)]
+    #[arg(long, allow_hyphen_values = true)]
     pub mu1: Option<f64>,
     /// Restitution between blocks.
-    #[arg(long)]
+    #[arg(long, allow_hyphen_values = true)]
     pub e1: Option<f64>,
     /// Sliding friction with the ground (sets --mu2-stick too unless given).
-    #[arg(long)]
+    #[arg(long, allow_hyphen_values = true)]
     pub mu2: Option<f64>,
     /// Restitution with the ground.
-    #[arg(long)]
+    #[arg(long, allow_hyphen_values = true)]
     pub e2: Option<f64>,
     /// Sticking friction between blocks.
-    #[arg(long)]
+    #[arg(long, allow_hyphen_values = true)]
     pub mu1_stick: Option<f64>,
     /// Sticking friction with the ground.
-    #[arg(long)]
+    #[arg(long, allow_hyphen_values = true)]
     pub mu2_stick: Option<f64>,
     /// Contact stiffness between blocks (N/m^α).
-    #[arg(long)]
+    #[arg(long, allow_hyphen_values = true)]
     pub k1: Option<f64>,
     /// Contact stiffness with the ground (N/m^α).
-    #[arg(long)]
+    #[arg(long, allow_hyphen_values = true)]
     pub k2: Option<f64>,
     /// Points under a standing block.
     #[arg(long)]
     pub lambda: Option<usize>,
     /// Exponent of the contact law.
-    #[arg(long)]
+    #[arg(long, allow_hyphen_values = true)]
     pub alpha: Option<f64>,
     /// Factor on the friction coefficients inside impacts (0.5 in the paper).
-    #[arg(long)]
+    #[arg(long, allow_hyphen_values = true)]
     pub impact_friction_factor: Option<f64>,
     /// Block height h (m).
-    #[arg(long)]
+    #[arg(long, allow_hyphen_values = true)]
     pub height: Option<f64>,
     /// Block thickness d (m).
-    #[arg(long)]
+    #[arg(long, allow_hyphen_values = true)]
     pub thickness: Option<f64>,
 }
 
@@ -115,11 +116,11 @@ pub struct Args {
     /// impacts keep the paper's impulse step) instead of the paper's improved
     /// Euler at --dt. With a Rapier engine: adaptive impulse stepping at this
     /// tolerance.
-    #[arg(long)]
+    #[arg(long, allow_hyphen_values = true)]
     pub tolerance: Option<f64>,
     /// Fixed time step of the paper's integration (s); with a Rapier engine,
     /// Rapier's time step.
-    #[arg(long, default_value_t = 1e-4)]
+    #[arg(long, allow_hyphen_values = true, default_value_t = 1e-4)]
     pub dt: f64,
     /// Rapier engines: impact window, the number of closed contacts from the
     /// struck pair beyond which bodies are left out of an impact.
@@ -127,11 +128,11 @@ pub struct Args {
     pub window: usize,
     /// Rapier engines: stop after this much simulated time (s) if the last
     /// block has not been hit.
-    #[arg(long, default_value_t = 60.0)]
+    #[arg(long, allow_hyphen_values = true, default_value_t = 60.0)]
     pub max_time: f64,
     /// Freeze blocks behind the wave below this speed (fraction of √(gh)) and
     /// acceleration (fraction of g); 0 never freezes.
-    #[arg(long)]
+    #[arg(long, allow_hyphen_values = true)]
     pub freeze_tolerance: Option<f64>,
     /// Reference engine: make the heel of every block a contact on the front
     /// face of the block behind (no overlap where blocks slide back; about
@@ -148,7 +149,7 @@ pub struct Args {
     #[arg(long, value_delimiter = ',')]
     pub series: Vec<usize>,
     /// Draw the row at these times (s) into --svg and/or --png.
-    #[arg(long, value_delimiter = ',')]
+    #[arg(long, allow_hyphen_values = true, value_delimiter = ',')]
     pub snapshots: Vec<f64>,
     /// SVG file for the snapshots.
     #[arg(long)]
@@ -156,6 +157,10 @@ pub struct Args {
     /// PNG file for the snapshots (same drawing, 4 px per mm, no labels).
     #[arg(long)]
     pub png: Option<PathBuf>,
+    /// Reference engine: stop after this much wall-clock time (s), print what
+    /// was measured and exit with status 1.
+    #[arg(long, allow_hyphen_values = true, default_value_t = 3600.0)]
+    pub wall_limit: f64,
 }
 
 /// Row parameters from a preset and the overrides.
@@ -208,21 +213,82 @@ pub fn params(args: &RowArgs) -> RowParams {
     p
 }
 
-/// The row to simulate.
-pub fn row_spec(args: &RowArgs) -> anyhow::Result<RowSpec> {
-    anyhow::ensure!(args.n >= 1, "--n must be at least 1");
+/// The row to simulate, checked against the limits of `docs/input-limits.md`
+/// for the engine and budget given (a reference run without a time step if
+/// `budget` is `None`).
+pub fn row_spec(args: &RowArgs, budget: Option<RunBudget>) -> anyhow::Result<RowSpec> {
     let p = params(args);
-    Ok(RowSpec::new(
-        p,
-        args.spacing_ratio * p.block.height,
-        args.n,
-        args.push,
-    ))
+    let row = RowSpec::new(p, args.spacing_ratio * p.block.height, args.n, args.push);
+    let budget = budget.unwrap_or(RunBudget {
+        engine: EngineKind::Reference,
+        dt: None,
+        tolerance: None,
+        max_time: None,
+        wall_limit: None,
+    });
+    validate::row(&row, &budget, Naming::Flags)?;
+    Ok(row)
+}
+
+/// Every flag in its range before anything runs (`docs/input-limits.md`).
+fn check_args(args: &Args) -> anyhow::Result<RowSpec> {
+    let engine = match args.engine {
+        EngineArg::Reference => EngineKind::Reference,
+        EngineArg::Rapier | EngineArg::RapierNative => EngineKind::Rapier,
+    };
+    let rapier = engine == EngineKind::Rapier;
+    let row = row_spec(
+        &args.row,
+        Some(RunBudget {
+            engine,
+            dt: Some(args.dt),
+            tolerance: args.tolerance,
+            max_time: rapier.then_some(args.max_time),
+            wall_limit: Some(args.wall_limit),
+        }),
+    )?;
+    validate::check_count("--window", args.window, 1, 1_000_000)?;
+    if let Some(f) = args.freeze_tolerance {
+        validate::check_range("--freeze-tolerance", f, 0.0, 1.0)?;
+    }
+    let drawing = args.svg.is_some() || args.png.is_some();
+    if !args.snapshots.is_empty() && !drawing {
+        Err(InputError::new(
+            "--snapshots",
+            "given without a file",
+            "with --svg FILE or --png FILE",
+        ))?;
+    }
+    if drawing && args.snapshots.is_empty() {
+        Err(InputError::new(
+            "--svg/--png",
+            "given without times",
+            "with --snapshots T1,T2,…",
+        ))?;
+    }
+    if let Some(&b) = args.series.iter().find(|&&b| b < 1 || b > row.n) {
+        Err(InputError::new(
+            "--series",
+            b,
+            format!("block numbers 1 ≤ --series ≤ {}", row.n),
+        ))?;
+    }
+    for &t in &args.snapshots {
+        validate::check_range("--snapshots", t, 0.0, 1e6)?;
+    }
+    if rapier && (drawing || !args.series.is_empty()) {
+        Err(InputError::new(
+            "--snapshots/--svg/--png/--series",
+            "given with a Rapier engine",
+            "with --engine reference only",
+        ))?;
+    }
+    Ok(row)
 }
 
 pub fn run(args: Args) -> anyhow::Result<()> {
-    let p = params(&args.row);
-    let row = row_spec(&args.row)?;
+    let row = check_args(&args)?;
+    let p = row.params;
     let mut settings = match args.tolerance {
         Some(tol) => Settings::accurate(tol),
         None => Settings {
@@ -236,38 +302,13 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     settings.heel_contacts = args.heel_contacts;
     settings.series_blocks = args.series.clone();
     settings.snapshot_times = args.snapshots.clone();
-    let drawing = args.svg.is_some() || args.png.is_some();
-    anyhow::ensure!(
-        args.snapshots.is_empty() || drawing,
-        "--snapshots needs --svg FILE or --png FILE to draw them into"
-    );
-    anyhow::ensure!(
-        !drawing || !args.snapshots.is_empty(),
-        "--svg and --png draw the times given by --snapshots T1,T2,…"
-    );
-    anyhow::ensure!(
-        args.series.iter().all(|&b| b >= 1 && b <= row.n),
-        "--series takes block numbers from 1 to {}",
-        row.n
-    );
-    anyhow::ensure!(
-        args.snapshots.iter().all(|t| t.is_finite() && *t >= 0.0),
-        "--snapshots takes times in seconds, ≥ 0"
-    );
+    settings.wall_time_limit = Some(args.wall_limit);
     let rapier_engine = match args.engine {
         EngineArg::Reference => None,
         EngineArg::Rapier => Some(topple::rapier::scene::Engine::Rapier),
         EngineArg::RapierNative => Some(topple::rapier::scene::Engine::RapierNative),
     };
     if let Some(engine) = rapier_engine {
-        anyhow::ensure!(
-            !drawing && args.series.is_empty(),
-            "--snapshots, --svg, --png and --series are for the reference engine"
-        );
-        anyhow::ensure!(
-            args.dt > 0.0 && args.dt.is_finite(),
-            "--dt must be a positive time step"
-        );
         let solver = topple::rapier::scene::SolverSpec {
             dt: args.dt,
             tolerance: args.tolerance,
@@ -303,17 +344,18 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     let out = out?;
     if let Some(path) = &args.svg {
         let svg = snapshot_svg(&p.block, &out.snapshots, 0, row.n - 1);
-        std::fs::write(path, svg).with_context(|| format!("writing {}", path.display()))?;
+        topple::atomic::write(path, svg.as_bytes())
+            .with_context(|| format!("writing {}", path.display()))?;
     }
     if let Some(path) = &args.png {
         let png = snapshot_png(&p.block, &out.snapshots, 0, row.n - 1, 4.0)
             .with_context(|| format!("encoding {}", path.display()))?;
-        std::fs::write(path, png).with_context(|| format!("writing {}", path.display()))?;
+        topple::atomic::write(path, &png).with_context(|| format!("writing {}", path.display()))?;
     }
     let r = &out.report;
     if args.json {
         println!("{}", serde_json::to_string_pretty(r)?);
-        return Ok(());
+        return budget_end(r, &row, args.wall_limit);
     }
     print_report(r, args.row.spacing_ratio, &row);
     println!(
@@ -333,6 +375,18 @@ pub fn run(args: Args) -> anyhow::Result<()> {
             println!("{:.6} {:.6} {:.6}", s.time[k], s.theta[k], s.theta_dot[k]);
         }
     }
+    budget_end(r, &row, args.wall_limit)
+}
+
+/// A reference run that hit its wall-clock budget: what it measured is
+/// printed; the command then fails with that budget named.
+fn budget_end(r: &topple::domino::ChainReport, row: &RowSpec, limit: f64) -> anyhow::Result<()> {
+    anyhow::ensure!(
+        !r.stopped_early,
+        "stopped by its budget, --wall-limit {limit} s, after {} of {} blocks were hit (their measures are printed above)",
+        r.hit_times.len(),
+        row.n
+    );
     Ok(())
 }
 

@@ -112,7 +112,12 @@ pub fn run(args: Args) -> anyhow::Result<()> {
 fn resolve_json(text: &str, max_steps: usize, e0_hold: bool) -> anyhow::Result<String> {
     // serde_json rejects NaN and infinities in JSON text already; the resolver
     // re-checks every value.
-    let input: Input = serde_json::from_str(text).context("invalid input JSON")?;
+    let input: Input = serde_json::from_str(text).map_err(|e| topple::validate::SyntaxError {
+        file: "input JSON".into(),
+        line: e.line(),
+        column: e.column(),
+        message: e.to_string(),
+    })?;
     let bodies: Vec<Body> = input
         .bodies
         .iter()
@@ -142,6 +147,12 @@ fn resolve_json(text: &str, max_steps: usize, e0_hold: bool) -> anyhow::Result<S
             },
         })
         .collect();
+    topple::validate::impact(&bodies, &contacts)?;
+    topple::validate::check_count("--max-steps", max_steps, 1, 1_000_000_000)?;
+    match input.tolerance {
+        Some(t) => topple::validate::check_range("tolerance", t, 1e-12, 0.1)?,
+        None => topple::validate::check_open_low("impulse_step", input.impulse_step, 0.0, 1.0)?,
+    };
     let step_control = match input.tolerance {
         Some(tolerance) => StepControl::Adaptive { tolerance },
         None => StepControl::Fixed {

@@ -1,6 +1,7 @@
 //! Command-line front end. Each subcommand lives in its own module with its
 //! `Args` and a `run` that returns `anyhow::Result<()>`; errors print as one
-//! line on stderr and exit with status 1 (2 for bad arguments, from clap).
+//! line on stderr and exit with status 2 for bad input (clap's errors and
+//! [`topple::validate`]'s, refused before any work starts), 1 otherwise.
 
 use clap::{Parser, Subcommand};
 
@@ -28,16 +29,22 @@ struct Cli {
 #[derive(Subcommand)]
 enum Command {
     /// Resolve one multiple impact given as JSON (FILE, or - for stdin).
+    #[command(allow_negative_numbers = true)]
     Impact(impact::Args),
     /// Run a TOML scene in Rapier, with topple's impacts or natively.
+    #[command(allow_negative_numbers = true)]
     Scene(scene::Args),
     /// Natural speed of the domino wave by the cooperative, extended and single collision models.
+    #[command(allow_negative_numbers = true)]
     Theory(theory::Args),
     /// Simulate a row of dominoes (the paper's model) and report the wave.
+    #[command(allow_negative_numbers = true)]
     Chain(chain::Args),
     /// Regenerate the paper's Figs. 3–10 (CSV + SVG) with the reference engine.
+    #[command(allow_negative_numbers = true)]
     Paper(paper::Args),
     /// Run time against accuracy of one row over engines and settings (a table).
+    #[command(allow_negative_numbers = true)]
     Bench(bench::Args),
 }
 
@@ -72,7 +79,14 @@ pub fn run() -> i32 {
             // One line: the error and its causes joined by ": ".
             let line = format!("{err:#}").replace('\n', " ");
             eprintln!("error: {line}");
-            1
+            let bad_input = err.chain().any(|e| {
+                e.is::<topple::validate::InputError>() || e.is::<topple::validate::SyntaxError>()
+            });
+            if bad_input {
+                2
+            } else {
+                1
+            }
         }
     }
 }

@@ -13,6 +13,7 @@ use plotters::style::RGBColor;
 use topple::domino::{ChainReport, Preset, RowParams, RowSpec};
 use topple::reference::{run, snapshot_svg, Integrator, Settings};
 use topple::theory::{self, Model};
+use topple::validate::{self, EngineKind, InputError};
 
 /// Arguments of `topple paper`.
 #[derive(clap::Args, Debug)]
@@ -27,15 +28,15 @@ pub struct Args {
     #[arg(long, value_delimiter = ',')]
     pub figs: Vec<u32>,
     /// Accurate integration at this tolerance instead of the paper's.
-    #[arg(long)]
+    #[arg(long, allow_hyphen_values = true)]
     pub tolerance: Option<f64>,
     /// Spacing ratios s/h of the sweeps of Figs. 4 and 5 (default 0.1 to 0.6
     /// in steps of 0.05).
-    #[arg(long, value_delimiter = ',')]
+    #[arg(long, allow_hyphen_values = true, value_delimiter = ',')]
     pub spacings: Vec<f64>,
     /// Wall-clock limit per run (s); a run that hits it keeps the blocks it
     /// measured and is reported on stderr.
-    #[arg(long, default_value_t = 120.0)]
+    #[arg(long, allow_hyphen_values = true, default_value_t = 120.0)]
     pub run_limit: f64,
 }
 
@@ -106,7 +107,29 @@ fn natural(r: &ChainReport) -> f64 {
     r.natural_speed.unwrap_or(f64::NAN)
 }
 
+/// Every flag in its range before anything runs (`docs/input-limits.md`).
+fn check_args(args: &Args) -> Result<(), InputError> {
+    validate::check_count("--n", args.n, 2, 100_000)?;
+    validate::check_memory("--n", args.n, EngineKind::Reference, None)?;
+    if let Some(&f) = args.figs.iter().find(|f| !(3..=10).contains(*f)) {
+        return Err(InputError::new(
+            "--figs",
+            f,
+            "figure numbers 3 ≤ --figs ≤ 10",
+        ));
+    }
+    if let Some(t) = args.tolerance {
+        validate::check_range("--tolerance", t, 1e-12, 1e-3)?;
+    }
+    for &sh in &args.spacings {
+        validate::check_open_low("--spacings", sh, 0.0, 0.999)?;
+    }
+    validate::check_open_low("--run-limit", args.run_limit, 0.0, 1e7)?;
+    Ok(())
+}
+
 pub fn run_cmd(args: Args) -> anyhow::Result<()> {
+    check_args(&args)?;
     std::fs::create_dir_all(&args.out)
         .with_context(|| format!("creating {}", args.out.display()))?;
     let want = |f: u32| args.figs.is_empty() || args.figs.contains(&f);
@@ -530,5 +553,5 @@ pub fn run_cmd(args: Args) -> anyhow::Result<()> {
 }
 
 fn write(path: &Path, s: &str) -> anyhow::Result<()> {
-    std::fs::write(path, s).with_context(|| format!("writing {}", path.display()))
+    topple::atomic::write(path, s.as_bytes()).with_context(|| format!("writing {}", path.display()))
 }

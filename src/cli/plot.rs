@@ -122,14 +122,31 @@ pub fn plot(
             }
         }
     };
-    let root = SVGBackend::new(path, (720, 480)).into_drawing_area();
+    let mut svg = String::new();
+    let bounds = (x0 - dx, x1 + dx, y0 - (y1 - y0).max(1e-9) * 0.08, y1 + dy);
+    draw(&mut svg, title, xlabel, ylabel, curves, bounds, legend)?;
+    topple::atomic::write(path, svg.as_bytes())
+        .with_context(|| format!("writing {}", path.display()))
+}
+
+/// Draws the plot into `svg` (the SVG text).
+fn draw(
+    svg: &mut String,
+    title: &str,
+    xlabel: &str,
+    ylabel: &str,
+    curves: &[Curve],
+    (x0, x1, y0, y1): (f64, f64, f64, f64),
+    legend: SeriesLabelPosition,
+) -> anyhow::Result<()> {
+    let root = SVGBackend::with_string(svg, (720, 480)).into_drawing_area();
     root.fill(&WHITE).map_err(|e| anyhow::anyhow!("{e}"))?;
     let mut chart = ChartBuilder::on(&root)
         .caption(title, ("sans-serif", 18))
         .margin(12)
         .x_label_area_size(40)
         .y_label_area_size(56)
-        .build_cartesian_2d(x0 - dx..x1 + dx, y0 - (y1 - y0).max(1e-9) * 0.08..y1 + dy)
+        .build_cartesian_2d(x0..x1, y0..y1)
         .map_err(|e| anyhow::anyhow!("{e}"))?;
     chart
         .configure_mesh()
@@ -217,5 +234,5 @@ pub fn csv(path: &Path, header: &str, rows: &[Vec<f64>]) -> anyhow::Result<()> {
         s.push_str(&line.join(","));
         s.push('\n');
     }
-    std::fs::write(path, s).with_context(|| format!("writing {}", path.display()))
+    topple::atomic::write(path, s.as_bytes()).with_context(|| format!("writing {}", path.display()))
 }

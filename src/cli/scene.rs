@@ -2,7 +2,8 @@
 
 use std::path::PathBuf;
 
-use topple::rapier::scene::{load_scene, run_scene, Engine, RunOptions};
+use anyhow::Context;
+use topple::rapier::scene::{run_scene, Engine, RunOptions, Scene};
 use topple::rapier::Precision;
 
 /// Arguments of `topple scene`.
@@ -30,7 +31,10 @@ pub struct Args {
 
 /// Runs the scene and prints final body states and the impacts resolved.
 pub fn run(args: Args) -> anyhow::Result<()> {
-    let scene = load_scene(&args.file)?;
+    let text = std::fs::read_to_string(&args.file)
+        .with_context(|| format!("reading {}", args.file.display()))?;
+    let scene: Scene = topple::validate::parse_toml(&text, &args.file.display().to_string())?;
+    topple::validate::scene(&scene)?;
     let options = RunOptions {
         stop_after_last_hit: args.until_last_hit,
         dump_fallback_impact: args.dump_fallback_impact.clone(),

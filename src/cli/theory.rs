@@ -14,16 +14,21 @@ pub struct Args {
     #[arg(long, value_enum)]
     pub model: Option<ModelName>,
     /// Block thickness over height, d/h, in (0, 1).
-    #[arg(long, value_name = "D_OVER_H", allow_negative_numbers = true)]
+    #[arg(
+        long,
+        allow_hyphen_values = true,
+        value_name = "D_OVER_H",
+        allow_negative_numbers = true
+    )]
     pub thickness_ratio: f64,
     /// Gap over height, s/h (> 0), or a sweep A:B:STEP (writes a CSV table and an SVG plot).
     #[arg(long, value_name = "S_OVER_H|A:B:STEP", allow_hyphen_values = true)]
     pub spacing_ratio: String,
     /// Friction coefficient between blocks (extended and single models).
-    #[arg(long, allow_negative_numbers = true)]
+    #[arg(long, allow_hyphen_values = true, allow_negative_numbers = true)]
     pub mu: Option<f64>,
     /// Coefficient of restitution between blocks (single collision model).
-    #[arg(long, allow_negative_numbers = true)]
+    #[arg(long, allow_hyphen_values = true, allow_negative_numbers = true)]
     pub e: Option<f64>,
     /// Print JSON (key "natural_speed" holds v/sqrt(gh), null without a wave).
     #[arg(long)]

@@ -25,11 +25,11 @@ pub enum SceneError {
         source: std::io::Error,
     },
     /// A scene file is not valid TOML for the format.
-    #[error("parsing {path}: {message}")]
+    #[error("{message}")]
     Parse {
         /// The file.
         path: std::path::PathBuf,
-        /// The parser's message.
+        /// `FILE:LINE:COLUMN: what is wrong`, on one line.
         message: String,
     },
 }

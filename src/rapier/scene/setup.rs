@@ -184,9 +184,11 @@ pub fn load_scene(path: &std::path::Path) -> SceneResult<Scene> {
         path: path.into(),
         source,
     })?;
-    toml::from_str(&text).map_err(|e| super::SceneError::Parse {
-        path: path.into(),
-        message: e.to_string(),
+    crate::validate::parse_toml(&text, &path.display().to_string()).map_err(|e| {
+        super::SceneError::Parse {
+            path: path.into(),
+            message: e.to_string(),
+        }
     })
 }
 
