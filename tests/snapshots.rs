@@ -122,22 +122,69 @@ fn chain_writes_png_and_svg_snapshots() {
 
 #[test]
 fn chain_refuses_drawing_options_it_would_ignore() {
+    // each refusal names the option at fault, before any work (exit 2)
     for (args, needle) in [
-        (vec!["--snapshots", "0.1"], "--snapshots needs"),
-        (vec!["--png", "x.png"], "--snapshots T1"),
-        (
-            vec!["--series", "7"],
-            "--series takes block numbers from 1 to 6",
-        ),
+        (vec!["--snapshots", "0.1"], "error: --snapshots "),
+        (vec!["--png", "x.png"], "error: --svg/--png "),
+        (vec!["--series", "7"], "error: --series = 7"),
         (
             vec!["--engine", "rapier", "--series", "2"],
-            "for the reference engine",
+            "--engine reference only",
         ),
     ] {
         let out = chain(&args);
-        assert!(!out.status.success(), "{args:?} was accepted");
+        assert_eq!(out.status.code(), Some(2), "{args:?}");
         let err = String::from_utf8_lossy(&out.stderr);
         assert!(err.contains(needle), "{args:?}: {err}");
         assert!(!err.contains("panicked"), "{err}");
     }
+}
+
+#[test]
+fn series_go_to_a_csv_file_not_to_stdout() {
+    let dir = std::env::temp_dir().join(format!("topple-series-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let csv = dir.join("series.csv");
+    let out = chain(&[
+        "--series",
+        "2,3",
+        "--series-csv",
+        csv.to_str().unwrap(),
+        "--json",
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let report: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let text = std::fs::read_to_string(&csv).unwrap();
+    let mut lines = text.lines();
+    assert_eq!(
+        lines.next(),
+        Some("block,t_s,theta_rad,theta_dot_rad_per_s")
+    );
+    let rows: Vec<Vec<f64>> = lines
+        .map(|l| l.split(',').map(|x| x.parse().unwrap()).collect())
+        .collect();
+    // one CSV row per recorded sample of each block, the same values as the
+    // JSON report's series (printed there with full precision)
+    for s in report["series"].as_array().unwrap() {
+        let block = s["block"].as_f64().unwrap();
+        let theta: Vec<f64> = serde_json::from_value(s["theta"].clone()).unwrap();
+        let mine: Vec<&Vec<f64>> = rows.iter().filter(|r| r[0] == block).collect();
+        assert_eq!(mine.len(), theta.len());
+        for (r, t) in mine.iter().zip(&theta) {
+            assert!((r[2] - t).abs() < 1e-8, "{} vs {t}", r[2]);
+        }
+    }
+    // alone, either option is refused before any work
+    for args in [
+        vec!["--series", "2"],
+        vec!["--series-csv", csv.to_str().unwrap()],
+    ] {
+        let out = chain(&args);
+        assert_eq!(out.status.code(), Some(2), "{args:?}");
+    }
+    std::fs::remove_dir_all(&dir).ok();
 }

@@ -145,9 +145,14 @@ pub struct Args {
     /// Print the report as JSON.
     #[arg(long)]
     pub json: bool,
-    /// Record θ and θ̇ of these blocks (1-based, comma-separated).
+    /// Record θ and θ̇ of these blocks (1-based, comma-separated) into
+    /// --series-csv.
     #[arg(long, value_delimiter = ',')]
     pub series: Vec<usize>,
+    /// CSV file for --series: block, t (s), θ (rad), θ̇ (rad/s), one row per
+    /// recorded step (clockwise positive, the paper's sign).
+    #[arg(long)]
+    pub series_csv: Option<PathBuf>,
     /// Draw the row at these times (s) into --svg and/or --png.
     #[arg(long, allow_hyphen_values = true, value_delimiter = ',')]
     pub snapshots: Vec<f64>,
@@ -283,6 +288,13 @@ fn check_args(args: &Args) -> anyhow::Result<RowSpec> {
             "with --engine reference only",
         ))?;
     }
+    if args.series.is_empty() != args.series_csv.is_none() {
+        Err(InputError::new(
+            "--series/--series-csv",
+            "given alone",
+            "together: --series BLOCKS --series-csv FILE",
+        ))?;
+    }
     Ok(row)
 }
 
@@ -353,6 +365,10 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         topple::atomic::write(path, &png).with_context(|| format!("writing {}", path.display()))?;
     }
     let r = &out.report;
+    if let Some(path) = &args.series_csv {
+        topple::atomic::write(path, series_csv(&r.series).as_bytes())
+            .with_context(|| format!("writing {}", path.display()))?;
+    }
     if args.json {
         println!("{}", serde_json::to_string_pretty(r)?);
         return budget_end(r, &row, args.wall_limit);
@@ -369,13 +385,21 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         r.run_time,
         out.steps
     );
-    for s in &r.series {
-        println!("# series block {}: t, θ, θ̇", s.block);
+    budget_end(r, &row, args.wall_limit)
+}
+
+/// The θ, θ̇ series of `topple chain --series` as CSV.
+fn series_csv(series: &[topple::domino::BlockSeries]) -> String {
+    let mut csv = String::from("block,t_s,theta_rad,theta_dot_rad_per_s\n");
+    for s in series {
         for k in 0..s.time.len() {
-            println!("{:.6} {:.6} {:.6}", s.time[k], s.theta[k], s.theta_dot[k]);
+            csv.push_str(&format!(
+                "{},{:.9},{:.9},{:.9}\n",
+                s.block, s.time[k], s.theta[k], s.theta_dot[k]
+            ));
         }
     }
-    budget_end(r, &row, args.wall_limit)
+    csv
 }
 
 /// A reference run that hit its wall-clock budget: what it measured is
