@@ -13,6 +13,7 @@
 //! | [`domino`] | block geometry, Table 1 presets, row builder, wave-speed measures |
 //! | [`theory`] | cooperative, extended and single-collision models of the wave |
 //! | [`reference`](mod@reference) | the paper's reduced-coordinate domino model (the accuracy oracle) |
+//! | [`engines`] | one interface ([`engines::RowEngine`]) for every engine that runs a domino row |
 //! | [`rapier`] | the plugin for Rapier, one source for `rapier2d-f64` and `rapier2d` (f32) |
 //! | [`validate`] | input checks at the entry points: field, value and allowed range on one line |
 //!
@@ -28,6 +29,7 @@
 pub mod atomic;
 pub mod coupling;
 pub mod domino;
+pub mod engines;
 pub mod impact;
 pub mod rapier;
 pub mod reference;

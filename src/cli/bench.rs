@@ -35,6 +35,7 @@ use anyhow::{bail, Context};
 
 use super::chain::{row_spec, RowArgs};
 use topple::domino::{ChainReport, RowSpec};
+use topple::engines::{RapierRow, ReferenceRow, RowEngine};
 use topple::rapier::scene::{Engine, SolverSpec};
 use topple::rapier::Precision;
 use topple::reference::{Integrator, Settings};
@@ -186,9 +187,21 @@ fn execute_with(
     kind: &RunKind,
     row: &RowSpec,
     args: &Args,
-    progress: impl FnMut(usize),
+    mut progress: impl FnMut(usize),
 ) -> anyhow::Result<ChainReport> {
-    Ok(match *kind {
+    let rapier = |engine, dt, impulse_step, tolerance, precision| RapierRow {
+        engine,
+        precision,
+        solver: SolverSpec {
+            dt,
+            impulse_step,
+            tolerance,
+            max_group_hops: Some(args.window),
+            ..Default::default()
+        },
+        max_time: args.max_time,
+    };
+    let engine: Box<dyn RowEngine> = match *kind {
         RunKind::Reference(integrator) => {
             let mut settings = Settings {
                 integrator,
@@ -197,40 +210,25 @@ fn execute_with(
             if let Some(f) = args.freeze_tolerance {
                 settings.freeze_tolerance = f;
             }
-            topple::reference::run_with_progress(row, &settings, progress)?.report
+            Box::new(ReferenceRow { settings })
         }
         RunKind::Rapier {
             dt,
             impulse_step,
             tolerance,
             precision,
-        } => topple::rapier::scene::run_row(
-            row,
+        } => Box::new(rapier(
             Engine::Rapier,
+            dt,
+            impulse_step,
+            tolerance,
             precision,
-            SolverSpec {
-                dt,
-                impulse_step,
-                tolerance,
-                max_group_hops: Some(args.window),
-                ..Default::default()
-            },
-            args.max_time,
-            progress,
-        )?,
-        RunKind::Native { dt, precision } => topple::rapier::scene::run_row(
-            row,
-            Engine::RapierNative,
-            precision,
-            SolverSpec {
-                dt,
-                max_group_hops: Some(args.window),
-                ..Default::default()
-            },
-            args.max_time,
-            progress,
-        )?,
-    })
+        )),
+        RunKind::Native { dt, precision } => {
+            Box::new(rapier(Engine::RapierNative, dt, None, None, precision))
+        }
+    };
+    Ok(engine.run(row, &mut progress)?)
 }
 
 fn file_name(run: &str) -> String {

@@ -6,6 +6,8 @@ use std::path::PathBuf;
 use anyhow::Context;
 
 use topple::domino::{Preset, RowParams, RowSpec};
+use topple::engines::{RapierRow, RowEngine};
+use topple::rapier::scene::{Engine, SolverSpec};
 use topple::reference::{snapshot_png, snapshot_svg, Integrator, Settings};
 use topple::validate::{self, EngineKind, InputError, Naming, RunBudget};
 
@@ -300,7 +302,15 @@ fn check_args(args: &Args) -> anyhow::Result<RowSpec> {
 
 pub fn run(args: Args) -> anyhow::Result<()> {
     let row = check_args(&args)?;
-    let p = row.params;
+    match args.engine {
+        EngineArg::Reference => run_reference(&args, &row),
+        EngineArg::Rapier => run_rapier(&args, &row, Engine::Rapier),
+        EngineArg::RapierNative => run_rapier(&args, &row, Engine::RapierNative),
+    }
+}
+
+/// The reference engine's settings from the command line.
+fn reference_settings(args: &Args) -> Settings {
     let mut settings = match args.tolerance {
         Some(tol) => Settings::accurate(tol),
         None => Settings {
@@ -315,43 +325,47 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     settings.series_blocks = args.series.clone();
     settings.snapshot_times = args.snapshots.clone();
     settings.wall_time_limit = Some(args.wall_limit);
-    let rapier_engine = match args.engine {
-        EngineArg::Reference => None,
-        EngineArg::Rapier => Some(topple::rapier::scene::Engine::Rapier),
-        EngineArg::RapierNative => Some(topple::rapier::scene::Engine::RapierNative),
-    };
-    if let Some(engine) = rapier_engine {
-        let solver = topple::rapier::scene::SolverSpec {
+    settings
+}
+
+/// A row through Rapier, with topple or natively.
+fn run_rapier(args: &Args, row: &RowSpec, engine: Engine) -> anyhow::Result<()> {
+    let rapier = RapierRow {
+        engine,
+        precision: args.precision,
+        solver: SolverSpec {
             dt: args.dt,
             tolerance: args.tolerance,
             max_group_hops: Some(args.window),
             ..Default::default()
-        };
-        let bar = super::blocks_bar(row.n, engine.name());
-        let report = topple::rapier::scene::run_row(
-            &row,
-            engine,
-            args.precision,
-            solver,
-            args.max_time,
-            |hit| bar.set_position(hit as u64),
+        },
+        max_time: args.max_time,
+    };
+    let bar = super::blocks_bar(row.n, engine.name());
+    let report = rapier.run(row, &mut |hit| bar.set_position(hit as u64));
+    bar.finish_and_clear();
+    let report = report?;
+    if args.json {
+        println!("{}", serde_json::to_string_pretty(&report)?);
+    } else {
+        print_report(&report, args.row.spacing_ratio, row);
+        println!(
+            "impacts {}, simulated {:.4} s in {:.3} s",
+            report.impacts, report.simulated_time, report.run_time
         );
-        bar.finish_and_clear();
-        let report = report?;
-        if args.json {
-            println!("{}", serde_json::to_string_pretty(&report)?);
-        } else {
-            print_report(&report, args.row.spacing_ratio, &row);
-            println!(
-                "impacts {}, simulated {:.4} s in {:.3} s",
-                report.impacts, report.simulated_time, report.run_time
-            );
-        }
-        return Ok(());
     }
+    Ok(())
+}
+
+/// A row through the reference engine, with its drawings and series (which
+/// only this engine records, so it is called directly rather than through
+/// [`RowEngine`]).
+fn run_reference(args: &Args, row: &RowSpec) -> anyhow::Result<()> {
+    let settings = reference_settings(args);
+    let p = row.params;
     let bar = super::blocks_bar(row.n, "reference");
     let out =
-        topple::reference::run_with_progress(&row, &settings, |hit| bar.set_position(hit as u64));
+        topple::reference::run_with_progress(row, &settings, |hit| bar.set_position(hit as u64));
     bar.finish_and_clear();
     let out = out?;
     if let Some(path) = &args.svg {
@@ -371,9 +385,9 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     }
     if args.json {
         println!("{}", serde_json::to_string_pretty(r)?);
-        return budget_end(r, &row, args.wall_limit);
+        return budget_end(r, row, args.wall_limit);
     }
-    print_report(r, args.row.spacing_ratio, &row);
+    print_report(r, args.row.spacing_ratio, row);
     println!(
         "impacts {} ({} with e = 0 contacts held, {} plastic fallbacks), max penetration {:.3e} m, blocks turning back: {:?}, simulated {:.4} s in {:.3} s ({} steps)",
         r.impacts,
@@ -385,7 +399,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         r.run_time,
         out.steps
     );
-    budget_end(r, &row, args.wall_limit)
+    budget_end(r, row, args.wall_limit)
 }
 
 /// The θ, θ̇ series of `topple chain --series` as CSV.
