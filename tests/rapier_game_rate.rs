@@ -114,12 +114,11 @@ fn a_cradle_of_boxes_keeps_momentum_and_energy_in_one_game_step() {
 /// independent integration of the same physics), in both builds, next to
 /// native Rapier on the same world.
 ///
-/// Measured when written: reference 1.778; topple f64 1.700 (−4.4 %), f32
-/// 1.691 (−4.9 %); native 1.460 (−17.9 %). The game-rate target of 3 % is
-/// not reached at 1/60 s (docs/game-rate.md explains what holds it back:
-/// Rapier's smooth phase between impacts at that step); the test holds
-/// what is reached: within 6 %, at most a third of native Rapier's error,
-/// and f32 within 1 % of f64.
+/// Measured when written: reference 1.778; topple f64 1.756 (−1.3 %), f32
+/// 1.767 (−0.6 %), with the default four sub-steps of the 1/60 s frame
+/// (1.700 and 1.691 without them); native 1.460 (−17.9 %). The test holds
+/// the game-rate targets: within 3 % of the reference, at most a third of
+/// native Rapier's error, and f32 within 1 % of f64.
 #[test]
 fn the_ideal_row_at_60_hz_is_close_to_the_reference_and_far_closer_than_native() {
     use topple::domino::{Preset, RowSpec};
@@ -153,7 +152,7 @@ fn the_ideal_row_at_60_hz_is_close_to_the_reference_and_far_closer_than_native()
         100.0 * err(native)
     );
     for v in [f64_, f32_] {
-        assert!(err(v).abs() < 0.06, "topple {v} against {reference}");
+        assert!(err(v).abs() < 0.03, "topple {v} against {reference}");
         assert!(
             3.0 * err(v).abs() <= err(native).abs(),
             "topple {v}, native {native}"

@@ -112,6 +112,13 @@ pub fn scene(s: &Scene) -> Result<(), InputError> {
     if let Some(x) = v.min_approach_speed {
         check_range("solver.min_approach_speed", x, 0.0, 1e3)?;
     }
+    if let Some(x) = v.max_substep {
+        check_range("solver.max_substep", x, 0.0, 1e3)?;
+        if x > 0.0 {
+            // at most 1,000 sub-steps per step
+            check_range("solver.dt / solver.max_substep", v.dt / x, 0.0, 1e3)?;
+        }
+    }
     check_range("solver.closed_tolerance", v.closed_tolerance, 0.0, 1.0)?;
     for (i, m) in s.materials.iter().enumerate() {
         law(

@@ -226,29 +226,72 @@ impl ToppleRapier {
         self.step_parts(StepParts::of(world), &(), &())
     }
 
-    /// One Rapier step with topple's hook in front of `user_hooks`, then the
-    /// impact pass: every impact of a managed pair is resolved at the instant
-    /// the pair closed, the bodies it changed move on from there to the end
-    /// of the step. Returns the number of impact groups resolved. Never
-    /// fails: an impact the LZB law cannot finish goes through the fallback
-    /// policy (counted in [`ToppleRapier::stats`]). The same as
-    /// [`ToppleRapier::begin_step`], Rapier's step with
-    /// [`ToppleRapier::hooks`], then [`ToppleRapier::end_step`].
+    /// One step of length `integration_parameters.dt`: Rapier with topple's
+    /// hook in front of `user_hooks`, taken as equal sub-steps no longer than
+    /// [`ToppleSettings::max_substep`], each split at the predicted impact
+    /// instants and followed by the impact pass: every impact of a managed
+    /// pair is resolved at the instant the pair closed, the bodies it changed
+    /// move on from there. Returns the number of impact groups resolved.
+    /// Never fails: an impact the LZB law cannot finish goes through the
+    /// fallback policy (counted in [`ToppleRapier::stats`]). An app that
+    /// calls Rapier's step itself uses [`ToppleRapier::begin_step`],
+    /// Rapier's step with [`ToppleRapier::hooks`], then
+    /// [`ToppleRapier::end_step`] instead (one piece, no splitting).
     pub fn step_parts(
         &mut self,
-        parts: StepParts<'_>,
+        mut parts: StepParts<'_>,
         user_hooks: &dyn PhysicsHooks,
         events: &dyn EventHandler,
     ) -> usize {
         self.pass.clear_step();
         let dt = parts.integration_parameters.dt;
+        let substeps = self.substeps(f64::from(dt));
+        let mut groups = 0;
+        for k in 0..substeps {
+            // the last sub-step ends exactly at dt
+            let start = dt * (k as Real) / (substeps as Real);
+            let end = if k + 1 == substeps {
+                dt
+            } else {
+                dt * ((k + 1) as Real) / (substeps as Real)
+            };
+            groups += self.substep(&mut parts, start, end, user_hooks, events);
+        }
+        groups
+    }
+
+    /// How many equal sub-steps a step of `dt` (s) takes
+    /// ([`ToppleSettings::max_substep`], at most 1,000; native Rapier never
+    /// sub-steps).
+    fn substeps(&self, dt: f64) -> usize {
+        match self.settings.max_substep {
+            Some(h) if self.hooks.mode == HookMode::Topple && h > 0.0 && dt > h => {
+                // a hair of tolerance so that 1/60 over 1/240 is 4, not 5
+                ((dt / h) * (1.0 - 1e-9)).ceil().min(1e3) as usize
+            }
+            _ => 1,
+        }
+    }
+
+    /// Rapier from `start` to `end` (s into the caller's step), split at the
+    /// predicted impact instants (at most [`ToppleSettings::max_splits`]
+    /// times), each piece followed by the impact pass. Returns the number of
+    /// impact groups resolved.
+    fn substep(
+        &mut self,
+        parts: &mut StepParts<'_>,
+        start: Real,
+        end: Real,
+        user_hooks: &dyn PhysicsHooks,
+        events: &dyn EventHandler,
+    ) -> usize {
         let mut params = *parts.integration_parameters;
-        let (mut done, mut groups) = (0.0 as Real, 0);
+        let (mut done, mut groups) = (start, 0);
         for split in 0..=self.settings.max_splits {
-            let remaining = dt - done;
+            let remaining = end - done;
             self.begin_step(parts.islands, parts.bodies);
             let h = if split < self.settings.max_splits {
-                self.split_length(&parts, remaining)
+                self.split_length(parts, remaining)
             } else {
                 remaining
             };

@@ -93,6 +93,10 @@ pub struct SolverSpec {
     /// Rapier steps split at predicted impact instants, at most, per step
     /// (default 4; 0 never splits).
     pub max_splits: Option<usize>,
+    /// Steps longer than this (s) are taken as equal sub-steps no longer
+    /// than it ([`crate::coupling::ToppleSettings::max_substep`], default
+    /// 1/240 s); 0: never sub-step. Native Rapier never sub-steps.
+    pub max_substep: Option<f64>,
     /// Gap (m) at or below which a contact point is closed.
     pub closed_tolerance: f64,
 }
@@ -111,6 +115,7 @@ impl Default for SolverSpec {
             lambda: 9,
             min_approach_speed: None,
             max_group_hops: None,
+            max_substep: None,
             closed_tolerance: 1e-9,
         }
     }

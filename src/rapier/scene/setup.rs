@@ -72,6 +72,10 @@ pub fn topple_settings(s: &SolverSpec, gravity: [f64; 2]) -> ToppleSettings {
             .or(ToppleSettings::default().max_group_hops),
         fallback: FallbackPolicy::default(),
         max_splits: s.max_splits.unwrap_or(ToppleSettings::default().max_splits),
+        max_substep: match s.max_substep {
+            None => ToppleSettings::default().max_substep,
+            Some(h) => (h > 0.0).then_some(h),
+        },
     }
 }
 
