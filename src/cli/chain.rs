@@ -5,7 +5,7 @@ use std::path::PathBuf;
 
 use anyhow::Context;
 
-use topple::domino::{Preset, RowParams, RowSpec};
+use topple::domino::{Ground, Preset, RowParams, RowSpec};
 use topple::reference::{snapshot_png, snapshot_svg, Integrator, Settings};
 
 /// Block type of Table 1.
@@ -100,6 +100,15 @@ pub struct RowArgs {
     /// Block thickness d (m).
     #[arg(long)]
     pub thickness: Option<f64>,
+    /// The ground under the feet: `coulomb` (the paper: μ2, halved inside
+    /// impacts) or `no-slip` (pivots that never slide, the cooperative
+    /// model's assumption).
+    #[arg(long, default_value = "coulomb", value_parser = parse_ground)]
+    pub ground: Ground,
+}
+
+fn parse_ground(s: &str) -> Result<Ground, String> {
+    s.parse()
 }
 
 /// Arguments of `topple chain`.
@@ -205,6 +214,7 @@ pub fn params(args: &RowArgs) -> RowParams {
     if let Some(v) = args.alpha {
         p.alpha = v;
     }
+    p.ground = args.ground;
     p
 }
 
