@@ -9,6 +9,7 @@
 //! | `reference:paper` | reference engine, the paper's improved Euler at 10⁻⁴ s |
 //! | `reference:paper:DT` | the same at time step DT (s) |
 //! | `reference:TOL` | reference engine, adaptive Dormand–Prince at tolerance TOL |
+//! | `reference:…:imp:TOL` | either of the above with the resolver's adaptive impulse stepping at TOL (never the default baseline) |
 //! | `rapier:DT` | Rapier with topple at its default settings, time step DT (s) |
 //! | `rapier:DT:STEP` | Rapier with topple, time step DT (s), fixed impulse step ΔP/P₀ = STEP |
 //! | `rapier:DT:tol:TOL` | Rapier with topple, adaptive impulse stepping at TOL |
@@ -78,6 +79,9 @@ pub struct Args {
 #[derive(Clone, Debug, PartialEq)]
 enum RunKind {
     Reference(Integrator),
+    /// The reference engine with the resolver's adaptive impulse stepping
+    /// at this tolerance (`…:imp:TOL`).
+    ReferenceAdaptiveImpacts(Integrator, f64),
     Rapier {
         dt: f64,
         impulse_step: Option<f64>,
@@ -113,6 +117,15 @@ fn parse_run(run: &str, default: Precision) -> anyhow::Result<RunKind> {
         parts.pop();
     }
     let precision = named.unwrap_or(default);
+    if let ["reference", head @ .., "imp", tol] = parts.as_slice() {
+        if !head.is_empty() {
+            let smooth = format!("reference:{}", head.join(":"));
+            let tol = number(tol, "impact tolerance", run)?;
+            if let RunKind::Reference(integrator) = parse_run(&smooth, default)? {
+                return Ok(RunKind::ReferenceAdaptiveImpacts(integrator, tol));
+            }
+        }
+    }
     Ok(match parts.as_slice() {
         ["reference", "paper"] => RunKind::Reference(Integrator::Paper { dt: 1e-4 }),
         ["reference", "paper", dt] => RunKind::Reference(Integrator::Paper {
@@ -144,7 +157,7 @@ fn parse_run(run: &str, default: Precision) -> anyhow::Result<RunKind> {
             precision,
         },
         _ => bail!(
-            "run {run:?} is not one of reference:paper[:DT], reference:TOL, \
+            "run {run:?} is not one of reference:paper[:DT], reference:TOL (either may end in :imp:TOL), \
              rapier:DT, rapier:DT:STEP, rapier:DT:tol:TOL, native:DT (Rapier runs may end in :f32 or :f64)"
         ),
     })
@@ -202,11 +215,15 @@ fn execute_with(
         max_time: args.max_time,
     };
     let engine: Box<dyn RowEngine> = match *kind {
-        RunKind::Reference(integrator) => {
+        RunKind::Reference(integrator) | RunKind::ReferenceAdaptiveImpacts(integrator, _) => {
             let mut settings = Settings {
                 integrator,
                 ..Default::default()
             };
+            if let RunKind::ReferenceAdaptiveImpacts(_, tol) = *kind {
+                settings.impact.step_control =
+                    topple::impact::StepControl::Adaptive { tolerance: tol };
+            }
             if let Some(f) = args.freeze_tolerance {
                 settings.freeze_tolerance = f;
             }
@@ -224,9 +241,13 @@ fn execute_with(
             tolerance,
             precision,
         )),
-        RunKind::Native { dt, precision } => {
-            Box::new(rapier(Engine::RapierNative, dt, None, None, precision))
-        }
+        RunKind::Native { dt, precision } => Box::new(rapier(
+            Engine::RapierNative,
+            dt,
+            None,
+            None,
+            precision,
+        )),
     };
     Ok(engine.run(row, &mut progress)?)
 }
@@ -286,7 +307,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         let path = args.out.as_ref().map(|d| d.join(file_name(&key)));
         // the freeze tolerance matters to reference runs only
         let freeze = match kind {
-            RunKind::Reference(_) => args.freeze_tolerance,
+            RunKind::Reference(_) | RunKind::ReferenceAdaptiveImpacts(..) => args.freeze_tolerance,
             _ => None,
         };
         let saved = path
@@ -353,7 +374,7 @@ fn front_speed(r: &ChainReport, row: &RowSpec) -> Option<f64> {
 fn rapier_dt(kind: &RunKind) -> Option<f64> {
     match *kind {
         RunKind::Rapier { dt, .. } | RunKind::Native { dt, .. } => Some(dt),
-        RunKind::Reference(_) => None,
+        RunKind::Reference(_) | RunKind::ReferenceAdaptiveImpacts(..) => None,
     }
 }
 
@@ -393,7 +414,7 @@ fn print_table(
         });
         let precision = match *kind {
             RunKind::Rapier { precision, .. } | RunKind::Native { precision, .. } => precision,
-            RunKind::Reference(_) => Precision::F64,
+            RunKind::Reference(_) | RunKind::ReferenceAdaptiveImpacts(..) => Precision::F64,
         };
         let native_ms = rapier_dt(kind).and_then(|dt| {
             kinds
@@ -449,6 +470,16 @@ mod tests {
             parse_run("reference:1e-8", Precision::F64).unwrap(),
             RunKind::Reference(Integrator::Adaptive { tolerance: 1e-8 })
         );
+        assert_eq!(
+            parse_run("reference:paper:imp:1e-4", Precision::F64).unwrap(),
+            RunKind::ReferenceAdaptiveImpacts(Integrator::Paper { dt: 1e-4 }, 1e-4)
+        );
+        assert_eq!(
+            parse_run("reference:1e-6:imp:1e-5", Precision::F64).unwrap(),
+            RunKind::ReferenceAdaptiveImpacts(Integrator::Adaptive { tolerance: 1e-6 }, 1e-5)
+        );
+        assert!(parse_run("reference:imp:1e-4", Precision::F64).is_err());
+        assert!(parse_run("reference:paper:imp:-1", Precision::F64).is_err());
         assert_eq!(
             parse_run("rapier:1e-3:1e-4", Precision::F64).unwrap(),
             RunKind::Rapier {

@@ -5,7 +5,7 @@ use std::path::PathBuf;
 
 use anyhow::Context;
 
-use topple::domino::{Preset, RowParams, RowSpec};
+use topple::domino::{Ground, Preset, RowParams, RowSpec};
 use topple::engines::{RapierRow, RowEngine};
 use topple::rapier::scene::{Engine, SolverSpec};
 use topple::reference::{snapshot_png, snapshot_svg, Integrator, Settings};
@@ -103,6 +103,15 @@ pub struct RowArgs {
     /// Block thickness d (m).
     #[arg(long, allow_hyphen_values = true)]
     pub thickness: Option<f64>,
+    /// The ground under the feet: `coulomb` (the paper: μ2, halved inside
+    /// impacts) or `no-slip` (pivots that never slide, the cooperative
+    /// model's assumption).
+    #[arg(long, default_value = "coulomb", value_parser = parse_ground)]
+    pub ground: Ground,
+}
+
+fn parse_ground(s: &str) -> Result<Ground, String> {
+    s.parse()
 }
 
 /// Arguments of `topple chain`.
@@ -217,6 +226,7 @@ pub fn params(args: &RowArgs) -> RowParams {
     if let Some(v) = args.alpha {
         p.alpha = v;
     }
+    p.ground = args.ground;
     p
 }
 

@@ -10,7 +10,7 @@ use rayon::prelude::*;
 
 use super::plot::{csv, plot, Curve, Style, COLOURS};
 use plotters::style::RGBColor;
-use topple::domino::{ChainReport, Preset, RowParams, RowSpec};
+use topple::domino::{ChainReport, Ground, Preset, RowParams, RowSpec};
 use topple::reference::{run, snapshot_svg, Integrator, Settings};
 use topple::theory::{self, Model};
 use topple::validate::{self, EngineKind, InputError};
@@ -69,7 +69,32 @@ fn set_mu2(mut p: RowParams, mu: f64) -> RowParams {
     p
 }
 
+/// Job id of the figure `fig5_ground`.
+const GROUND_FIG: u32 = 50;
+/// Friction between blocks of the second set of rows in `fig5_ground`.
+const GROUND_MU1: f64 = 0.15;
+
+/// The rows of `fig5_ground`: the ideal Domino T row with μ1 = 0 and 0.15,
+/// each on a no-slip ground, with the paper's halved impact friction and
+/// with full impact friction (μ2 = 0.9 in and out of impacts).
+fn ground_variants() -> Vec<(String, RowParams)> {
+    let ideal = Preset::T.params().ideal();
+    let mut v = Vec::new();
+    for mu1 in [0.0, GROUND_MU1] {
+        let p = set_mu1(ideal, mu1);
+        let mut no_slip = p;
+        no_slip.ground = Ground::NoSlip;
+        let mut full = p;
+        full.impact_friction_factor = 1.0;
+        v.push((format!("no-slip, mu1 = {mu1}"), no_slip));
+        v.push((format!("halved impact friction, mu1 = {mu1}"), p));
+        v.push((format!("full impact friction, mu1 = {mu1}"), full));
+    }
+    v
+}
+
 /// A theory line of Figs. 4 and 5 (`crate::theory`).
+#[derive(Clone)]
 struct TheoryLine {
     name: String,
     thickness_ratio: f64,
@@ -199,6 +224,14 @@ pub fn run_cmd(args: Args) -> anyhow::Result<()> {
                 n,
                 &base,
             ));
+        }
+    }
+    if want(5) {
+        // fig5_ground (id 50): the ground law under the ideal row
+        for (name, p) in ground_variants() {
+            for &sh in &spacings {
+                jobs.push(mk(GROUND_FIG, name.clone(), sh, p, sh, 1.0, n, &base));
+            }
         }
     }
     if want(6) || want(7) {
@@ -370,72 +403,79 @@ pub fn run_cmd(args: Args) -> anyhow::Result<()> {
         along(8, "Fig. 8: Domino X, s/h = 0.52, pushes 0.5/1.0/1.8")?;
     }
     // sweeps (Figs. 4, 5, 9, 10); theory lines (Figs. 4, 5) after the simulations
-    let sweep =
-        |fig: u32, sub: &str, title: &str, xl: &str, lines: &[TheoryLine]| -> anyhow::Result<()> {
-            let v: Vec<(&Job, &ChainReport)> = pick(fig)
-                .into_iter()
-                .filter(|(j, _)| sub.is_empty() || j.key.starts_with(sub))
+    let sweep_named = |fig: u32,
+                       sub: &str,
+                       name: &str,
+                       title: &str,
+                       xl: &str,
+                       lines: &[TheoryLine]|
+     -> anyhow::Result<()> {
+        let v: Vec<(&Job, &ChainReport)> = pick(fig)
+            .into_iter()
+            .filter(|(j, _)| sub.is_empty() || j.key.starts_with(sub))
+            .collect();
+        let mut rows = Vec::new();
+        let mut curves = Vec::new();
+        let mut names = keys(&v);
+        for (ki, k) in keys(&v).iter().enumerate() {
+            let pts: Vec<(f64, f64)> = v
+                .iter()
+                .filter(|(j, _)| &j.key == k)
+                .map(|(j, r)| (j.x, natural(r)))
                 .collect();
-            let mut rows = Vec::new();
-            let mut curves = Vec::new();
-            let mut names = keys(&v);
-            for (ki, k) in keys(&v).iter().enumerate() {
-                let pts: Vec<(f64, f64)> = v
+            for (xv, yv) in &pts {
+                let spread = v
                     .iter()
-                    .filter(|(j, _)| &j.key == k)
-                    .map(|(j, r)| (j.x, natural(r)))
-                    .collect();
-                for (xv, yv) in &pts {
-                    let spread = v
-                        .iter()
-                        .find(|(j, _)| &j.key == k && j.x == *xv)
-                        .and_then(|(_, r)| r.natural_speed_spread)
-                        .map(|s| s.std_dev)
-                        .unwrap_or(f64::NAN);
-                    rows.push(vec![ki as f64, *xv, *yv, spread]);
-                }
-                curves.push(Curve {
-                    name: k.trim_start_matches(sub).trim().to_string(),
-                    points: pts,
-                    // with theory lines the simulations are points; alone, the
-                    // points of a parameter sweep are joined to show the trend
-                    style: if lines.is_empty() {
-                        Style::MarkersLine
-                    } else {
-                        Style::Markers
-                    },
-                    colour: None,
-                });
+                    .find(|(j, _)| &j.key == k && j.x == *xv)
+                    .and_then(|(_, r)| r.natural_speed_spread)
+                    .map(|s| s.std_dev)
+                    .unwrap_or(f64::NAN);
+                rows.push(vec![ki as f64, *xv, *yv, spread]);
             }
-            let grid = theory_grid(&v.iter().map(|(j, _)| j.x).collect::<Vec<_>>());
-            for line in lines {
-                let ki = names.len();
-                names.push(format!("theory {}", line.name));
-                let sweep = theory::sweep(&[line.model], line.thickness_ratio, &grid)
-                    .map_err(|e| anyhow::anyhow!("fig {fig} theory {}: {e}", line.name))?;
-                let pts: Vec<(f64, f64)> = sweep
-                    .iter()
-                    .map(|r| {
-                        let y = r.outcomes[0].natural_speed().unwrap_or(f64::NAN);
-                        (r.spacing_ratio, y)
-                    })
-                    .collect();
-                // no wave: no row in the CSV, a gap in the line
-                for (xv, yv) in pts.iter().filter(|p| p.1.is_finite()) {
-                    rows.push(vec![ki as f64, *xv, *yv, f64::NAN]);
-                }
-                curves.push(Curve {
-                    name: line.name.clone(),
-                    points: pts,
-                    style: line.style,
-                    colour: Some(line.colour),
-                });
+            curves.push(Curve {
+                name: k.trim_start_matches(sub).trim().to_string(),
+                points: pts,
+                // with theory lines the simulations are points; alone, the
+                // points of a parameter sweep are joined to show the trend
+                style: if lines.is_empty() {
+                    Style::MarkersLine
+                } else {
+                    Style::Markers
+                },
+                colour: None,
+            });
+        }
+        let grid = theory_grid(&v.iter().map(|(j, _)| j.x).collect::<Vec<_>>());
+        for line in lines {
+            let ki = names.len();
+            names.push(format!("theory {}", line.name));
+            let sweep = theory::sweep(&[line.model], line.thickness_ratio, &grid)
+                .map_err(|e| anyhow::anyhow!("fig {fig} theory {}: {e}", line.name))?;
+            let pts: Vec<(f64, f64)> = sweep
+                .iter()
+                .map(|r| {
+                    let y = r.outcomes[0].natural_speed().unwrap_or(f64::NAN);
+                    (r.spacing_ratio, y)
+                })
+                .collect();
+            // no wave: no row in the CSV, a gap in the line
+            for (xv, yv) in pts.iter().filter(|p| p.1.is_finite()) {
+                rows.push(vec![ki as f64, *xv, *yv, f64::NAN]);
             }
-            let name = format!("fig{fig}{sub}");
-            let header = format!("curve({}),x,v_na,v_na_std", names.join("|"));
-            csv(&out.join(format!("{name}.csv")), &header, &rows)?;
-            plot(&out.join(format!("{name}.svg")), title, xl, "v̂_na", &curves)
-        };
+            curves.push(Curve {
+                name: line.name.clone(),
+                points: pts,
+                style: line.style,
+                colour: Some(line.colour),
+            });
+        }
+        let header = format!("curve({}),x,v_na,v_na_std", names.join("|"));
+        csv(&out.join(format!("{name}.csv")), &header, &rows)?;
+        plot(&out.join(format!("{name}.svg")), title, xl, "v̂_na", &curves)
+    };
+    let sweep = |fig: u32, sub: &str, title: &str, xl: &str, lines: &[TheoryLine]| {
+        sweep_named(fig, sub, &format!("fig{fig}{sub}"), title, xl, lines)
+    };
     if want(4) {
         // Fig. 4: Stronge's cooperative group model for T (solid) and P (dot-dash)
         let lines: Vec<TheoryLine> = [
@@ -483,6 +523,29 @@ pub fn run_cmd(args: Args) -> anyhow::Result<()> {
             },
         ];
         sweep(5, "", "Fig. 5: Domino T, mu2 = 0.9, e2 = 0", "s/h", &lines)?;
+        let mu = GROUND_MU1;
+        let ground_lines = [
+            TheoryLine {
+                name: "cooperative (mu = 0)".into(),
+                model: Model::Cooperative,
+                style: Style::Line,
+                ..lines[0].clone()
+            },
+            TheoryLine {
+                name: format!("extended (mu = {mu})"),
+                model: Model::Extended { mu },
+                style: Style::Dashed,
+                ..lines[1].clone()
+            },
+        ];
+        sweep_named(
+            GROUND_FIG,
+            "",
+            "fig5_ground",
+            "Ideal Domino T (mu2 = 0.9, e1 = e2 = 0): the ground law",
+            "s/h",
+            &ground_lines,
+        )?;
     }
     if want(9) {
         sweep(9, "a", "Fig. 9a: X, mu2 = 0.9, e1 = e2 = 0", "mu1", &[])?;

@@ -19,7 +19,8 @@ pub struct ContactMaterial {
     pub exponent: f64,
     /// Energetic coefficient of restitution e ∈ [0, 1].
     pub restitution: f64,
-    /// Sliding friction μ ≥ 0 used during the impact.
+    /// Sliding friction μ ≥ 0 used during the impact; `f64::INFINITY` is a
+    /// contact that never slides ([`ContactMaterial::no_slip`]).
     pub friction: f64,
     /// Sticking friction μ_s ≥ 0: a sticking contact stays stuck while
     /// |dP_t| ≤ μ_s dP_n.
@@ -49,6 +50,28 @@ impl ContactMaterial {
         self.friction = friction;
         self.stick_friction = stick_friction;
         self
+    }
+
+    /// Same material without slip: μ = μ_s = ∞. While the contact takes
+    /// normal impulse its tangential impulse is whatever stops its slip
+    /// (unbounded, not a large finite μ); it may still separate. The
+    /// assumption of a pivot that holds (the cooperative domino model).
+    ///
+    /// ```
+    /// use topple::impact::ContactMaterial;
+    /// let m = ContactMaterial::hertz(1e9).no_slip();
+    /// assert!(m.is_no_slip());
+    /// assert!(!ContactMaterial::hertz(1e9).with_friction(1e6, 1e6).is_no_slip());
+    /// ```
+    pub fn no_slip(mut self) -> Self {
+        self.friction = f64::INFINITY;
+        self.stick_friction = f64::INFINITY;
+        self
+    }
+
+    /// Whether the contact never slides (μ = ∞).
+    pub fn is_no_slip(&self) -> bool {
+        self.friction == f64::INFINITY
     }
 
     /// Same material with another exponent α.

@@ -19,7 +19,9 @@
 //! 4. held contacts and Coulomb friction on the whole step, by projected
 //!    Gauss–Seidel: a contact without slip stays stuck if that needs
 //!    |dP_t| ≤ μ_s dP_n, else it slides the way it is pushed; a sliding
-//!    contact takes |dP_t| = μ dP_n against its slip;
+//!    contact takes |dP_t| = μ dP_n against its slip; a no-slip contact
+//!    (μ = ∞) takes the tangential impulse that stops its slip, unbounded,
+//!    while it takes normal impulse (so it may still lift off);
 //! 5. landing: every impulse of the step scales with its length, so the
 //!    velocities are linear in it; the step is shortened to end where a
 //!    contact's compression ends, its energy runs out (quadratic), a resting
@@ -99,6 +101,15 @@ impl Row {
             arm_a: self.a_rt,
             arm_b: self.b_rt,
         }
+    }
+
+    /// Unbounded friction (μ = ∞, [`ContactMaterial::no_slip`]): the
+    /// contact never slides while it takes normal impulse.
+    ///
+    /// [`ContactMaterial::no_slip`]: super::ContactMaterial::no_slip
+    #[inline]
+    fn no_slip(&self) -> bool {
+        self.friction == f64::INFINITY
     }
 
     #[inline]
@@ -860,7 +871,10 @@ impl ImpactSolver {
                 if inc <= 0.0 || !Self::has_friction(row) {
                     continue;
                 }
-                let (value, sticking) = if self.stuck_at_start[i] {
+                // A no-slip contact (μ = ∞) takes whatever tangential
+                // impulse stops its slip, whether or not it slipped at the
+                // start: the limit μ → ∞ of the sliding branch.
+                let (value, sticking) = if self.stuck_at_start[i] || row.no_slip() {
                     let slip = Self::tangent_rate(row, &self.trial);
                     let wanted = self.tangent_step[i] - slip / row.w_tt;
                     if wanted.abs() <= row.stick_friction.max(row.friction) * inc {
@@ -966,7 +980,7 @@ impl ImpactSolver {
                 length = length.min(at);
             }
             // a sliding contact's slip stops
-            if inc > 0.0 && !self.stuck_at_start[i] && Self::has_friction(row) {
+            if inc > 0.0 && !self.stuck_at_start[i] && !row.no_slip() && Self::has_friction(row) {
                 let slip0 = Self::tangent_rate(row, &self.velocity);
                 let slip1 = Self::tangent_rate(row, &self.trial);
                 if slip0 * slip1 < 0.0 {

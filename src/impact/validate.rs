@@ -54,8 +54,8 @@ pub(crate) fn check(
             && m.stiffness.is_finite()
             && m.exponent.is_finite()
             && m.restitution.is_finite()
-            && m.friction.is_finite()
-            && m.stick_friction.is_finite())
+            && !m.friction.is_nan()
+            && !m.stick_friction.is_nan())
         {
             return Err(bad("a value is NaN or infinite".into()));
         }

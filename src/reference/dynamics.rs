@@ -9,7 +9,7 @@
 
 use super::band::Band;
 use super::geometry::{geom, kin, Geom, Kin, Surface};
-use crate::domino::RowParams;
+use crate::domino::{Ground, RowParams};
 
 /// Friction state of a pressing contact.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -124,11 +124,28 @@ impl RowConst {
             reg: 1e-10,
         }
     }
+    /// Sliding and sticking friction (μ, μ_s) of a slot in the smooth
+    /// phase; both are ∞ on a no-slip ground ([`Ground::NoSlip`]), whose
+    /// contacts are always in [`Mode::Stick`].
     #[inline]
     pub fn mu(&self, slot: usize) -> (f64, f64) {
         match super::geometry::surface(slot, self.p.lambda_points) {
+            Surface::Ground if self.p.ground == Ground::NoSlip => (f64::INFINITY, f64::INFINITY),
             Surface::Ground => (self.p.mu2, self.p.mu2_stick),
             Surface::Block => (self.p.mu1, self.p.mu1_stick),
+        }
+    }
+
+    /// How much the tangential force of a sticking contact exceeds its
+    /// limit, |F_t| − μ_s F_n (N), for the mode search and the stick → slip
+    /// event; −∞ without a limit (μ_s = ∞).
+    #[inline]
+    pub fn stick_excess(&self, slot: usize, ft: f64, fnn: f64) -> f64 {
+        let (_, mus) = self.mu(slot);
+        if mus == f64::INFINITY {
+            f64::NEG_INFINITY
+        } else {
+            ft.abs() - mus * fnn
         }
     }
     #[inline]

@@ -355,11 +355,13 @@ impl Engine {
         self.ref_stick.clear();
         self.ref_slide.clear();
         for (c, a) in self.active.iter().enumerate() {
-            let (_, mus) = self.rc.mu(a.slot);
             let fnn = self.dynamics.fn_[c];
             self.ref_fn.push(fnn.min(0.0));
-            self.ref_stick
-                .push((self.dynamics.ft[c].abs() - mus * fnn).max(0.0));
+            self.ref_stick.push(
+                self.rc
+                    .stick_excess(a.slot, self.dynamics.ft[c], fnn)
+                    .max(0.0),
+            );
             let dir = match a.mode {
                 Mode::Slide(d) => d,
                 _ => 0.0,
@@ -374,7 +376,6 @@ impl Engine {
     fn events_at(&mut self, y1: &[f64]) -> bool {
         let mut event = false;
         for (c, a) in self.active.iter().enumerate() {
-            let (_, mus) = self.rc.mu(a.slot);
             let d = &self.dynamics;
             let fnn = d.fn_[c];
             if !d.valid[c] || fnn < self.ref_fn[c] - self.tol.force {
@@ -382,7 +383,9 @@ impl Engine {
             }
             match a.mode {
                 Mode::Stick => {
-                    if d.ft[c].abs() - mus * fnn > self.ref_stick[c] + self.tol.force {
+                    if self.rc.stick_excess(a.slot, d.ft[c], fnn)
+                        > self.ref_stick[c] + self.tol.force
+                    {
                         event = true;
                     }
                 }

@@ -10,6 +10,7 @@
 use super::dynamics::{Active, Mode};
 use super::engine::{Engine, EngineError};
 use super::geometry::{surface, Surface};
+use crate::domino::Ground;
 use crate::impact::{Body, Contact, ContactMaterial, ImpactOutcome};
 
 /// Buffers of [`Engine::resolve_impacts`], kept between impacts so that a
@@ -78,7 +79,7 @@ impl Engine {
             Surface::Ground => (p.k2, p.e2, p.mu2, p.mu2_stick),
             Surface::Block => (p.k1, p.e1, p.mu1, p.mu1_stick),
         };
-        ContactMaterial {
+        let material = ContactMaterial {
             stiffness: k,
             exponent: p.alpha,
             restitution: e,
@@ -88,6 +89,13 @@ impl Engine {
             // while that needs |dP_t| ≤ μ_s dP_n with the table's μ_s.
             friction: f * mu,
             stick_friction: mus,
+        };
+        // A no-slip ground holds the feet inside impacts too: unbounded
+        // tangential impulse (μ = ∞ in the resolver), whatever the factor.
+        if p.ground == Ground::NoSlip && surface(slot, p.lambda_points) == Surface::Ground {
+            material.no_slip()
+        } else {
+            material
         }
     }
 

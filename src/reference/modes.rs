@@ -26,7 +26,11 @@ pub(crate) struct ModeTol {
 
 pub(crate) fn initial_mode(rc: &RowConst, slot: usize, vt: f64, tol: &ModeTol) -> Mode {
     let (mu, mus) = rc.mu(slot);
-    if vt.abs() <= tol.velocity && mus > 0.0 {
+    if mus == f64::INFINITY {
+        // no slip: a closing contact sticks at once (the impact or the
+        // projection stops its slip)
+        Mode::Stick
+    } else if vt.abs() <= tol.velocity && mus > 0.0 {
         Mode::Stick
     } else if mu > 0.0 {
         Mode::Slide(vt.signum())
@@ -82,7 +86,9 @@ pub(crate) fn select(
                     let (mu, mus) = rc.mu(c.slot);
                     if fnn < -tol.force {
                         Some((-fnn, None))
-                    } else if *mode == Mode::Stick && ft.abs() > mus * fnn.max(0.0) + tol.force {
+                    } else if *mode == Mode::Stick
+                        && rc.stick_excess(c.slot, ft, fnn.max(0.0)) > tol.force
+                    {
                         let next = if mu > 0.0 {
                             Mode::Slide(-ft.signum())
                         } else {
