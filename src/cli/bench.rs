@@ -241,13 +241,9 @@ fn execute_with(
             tolerance,
             precision,
         )),
-        RunKind::Native { dt, precision } => Box::new(rapier(
-            Engine::RapierNative,
-            dt,
-            None,
-            None,
-            precision,
-        )),
+        RunKind::Native { dt, precision } => {
+            Box::new(rapier(Engine::RapierNative, dt, None, None, precision))
+        }
     };
     Ok(engine.run(row, &mut progress)?)
 }

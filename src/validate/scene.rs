@@ -130,6 +130,7 @@ pub fn scene(s: &Scene) -> Result<(), InputError> {
                 friction: m.friction,
                 stick_friction: m.stick_friction,
                 impact_friction_factor: m.impact_friction_factor,
+                no_slip: false,
             },
         )?;
     }

@@ -173,6 +173,7 @@ fn register_materials(
             friction: m.friction,
             stick_friction: m.stick_friction,
             impact_friction_factor: m.impact_friction_factor,
+            no_slip: false,
         };
         if ids
             .insert(m.name.clone(), topple.add_material(pair_material(&law)))

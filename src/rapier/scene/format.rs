@@ -184,6 +184,12 @@ pub struct PairLaw {
     /// Factor on μ inside impacts.
     #[serde(default = "one")]
     pub impact_friction_factor: f64,
+    /// The pair never slides (a no-slip ground): unbounded friction inside
+    /// impacts and [`crate::rapier::scene::NO_SLIP_FRICTION`] in Rapier's
+    /// smooth phase; `friction`, `stick_friction` and
+    /// `impact_friction_factor` are then not used.
+    #[serde(default)]
+    pub no_slip: bool,
 }
 
 /// The ground: a fixed slab whose top face is at height `y`.

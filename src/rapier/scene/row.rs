@@ -10,7 +10,8 @@ use super::format::{
 };
 
 /// Friction coefficient that stands for "never slips" in Rapier's smooth
-/// phase and in topple's impacts on a [`Ground::NoSlip`] row. The ratio of
+/// phase on a [`Ground::NoSlip`] row (inside topple's impacts the friction
+/// is unbounded, [`crate::impact::ContactMaterial::no_slip`]). The ratio of
 /// tangential to normal force at the pivot of a toppling block is of order 1
 /// (at most (s + d)/h-ish while it leans on its neighbour), so a bound of
 /// 10³ is never reached: the contact sticks whenever it is closed.
@@ -67,8 +68,8 @@ pub fn row_params(row: &RowSpec, gravity: f64) -> SceneResult<RowParams> {
 /// sees it ([`row_params`] and the scene's spacing, n and push). Blocks
 /// stand on the ground at y = 0, block i (from 1) centred at
 /// x = (i − 1)(s + d); block 1 rotates clockwise about its front bottom edge
-/// at θ̇ = push/t̄. A [`Ground::NoSlip`] row gets [`NO_SLIP_FRICTION`] at
-/// the block–ground pair, not halved inside impacts.
+/// at θ̇ = push/t̄. A [`Ground::NoSlip`] row's block–ground pair is
+/// `no_slip`.
 pub fn expand_row(scene: &mut Scene, row: &RowSpec) -> SceneResult<DominoRow> {
     let g = scene.gravity[0].hypot(scene.gravity[1]);
     let p = row_params(row, g)?;
@@ -80,12 +81,16 @@ pub fn expand_row(scene: &mut Scene, row: &RowSpec) -> SceneResult<DominoRow> {
         friction: mu,
         stick_friction: mus,
         impact_friction_factor: factor,
+        no_slip: false,
     };
     let factor = p.impact_friction_factor;
     let block = law(p.mu1, p.mu1_stick, p.e1, p.k1, factor);
     let ground = match p.ground {
         Ground::Coulomb => law(p.mu2, p.mu2_stick, p.e2, p.k2, factor),
-        Ground::NoSlip => law(NO_SLIP_FRICTION, NO_SLIP_FRICTION, p.e2, p.k2, 1.0),
+        Ground::NoSlip => PairLaw {
+            no_slip: true,
+            ..law(NO_SLIP_FRICTION, NO_SLIP_FRICTION, p.e2, p.k2, 1.0)
+        },
     };
     let material = |name: &str, l: &PairLaw| MaterialSpec {
         name: name.into(),

@@ -37,6 +37,15 @@ impl Engine {
 }
 
 pub(crate) fn pair_material(l: &PairLaw) -> PairMaterial {
+    if l.no_slip {
+        return PairMaterial {
+            impact: ContactMaterial::hertz(l.stiffness)
+                .with_exponent(l.exponent)
+                .with_restitution(l.restitution)
+                .no_slip(),
+            smooth_friction: super::NO_SLIP_FRICTION,
+        };
+    }
     PairMaterial::from_table(
         ContactMaterial {
             stiffness: l.stiffness,
