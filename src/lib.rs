@@ -14,6 +14,7 @@
 //! | [`theory`] | cooperative, extended and single-collision models of the wave |
 //! | [`reference`] | the paper's reduced-coordinate domino model (the accuracy oracle) |
 //! | [`rapier`] | the plugin for Rapier, one source for `rapier2d-f64` and `rapier2d` (f32) |
+//! | [`stress`] | the stress sweep: seeded combinations over every engine, invariants checked independently |
 //! | [`validate`] | input checks at the entry points: field, value and allowed range on one line |
 //!
 //! Data flows down the table: a module uses the ones above it, never one below.
@@ -31,6 +32,7 @@ pub mod domino;
 pub mod impact;
 pub mod rapier;
 pub mod reference;
+pub mod stress;
 pub mod theory;
 pub mod validate;
 

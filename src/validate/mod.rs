@@ -26,6 +26,7 @@ mod scene;
 pub use impact::impact;
 pub use memory::{available_memory, check_memory, memory_estimate, EngineKind};
 pub use row::{row, Naming, RunBudget};
+pub(crate) use scene::box_overlap;
 pub use scene::{parse_toml, scene, SyntaxError};
 
 /// A value outside its allowed range: the field, the value as given and the
