@@ -15,6 +15,7 @@
 //! | [`reference`](mod@reference) | the paper's reduced-coordinate domino model (the accuracy oracle) |
 //! | [`engines`] | one interface ([`engines::RowEngine`]) for every engine that runs a domino row |
 //! | [`rapier`] | the plugin for Rapier, one source for `rapier2d-f64` and `rapier2d` (f32) |
+//! | [`stress`] | the stress sweep: seeded combinations over every engine, invariants checked independently |
 //! | [`validate`] | input checks at the entry points: field, value and allowed range on one line |
 //!
 //! Data flows down the table: a module uses the ones above it, never one below.
@@ -33,6 +34,7 @@ pub mod engines;
 pub mod impact;
 pub mod rapier;
 pub mod reference;
+pub mod stress;
 pub mod theory;
 pub mod validate;
 

@@ -11,6 +11,7 @@ mod impact;
 mod paper;
 mod plot;
 mod scene;
+mod stress;
 mod theory;
 
 #[derive(Parser)]
@@ -46,6 +47,8 @@ enum Command {
     /// Run time against accuracy of one row over engines and settings (a table).
     #[command(allow_negative_numbers = true)]
     Bench(bench::Args),
+    /// Seeded sweep over engines and parameters, invariants checked (a table; non-zero exit on a violation).
+    Stress(stress::Args),
 }
 
 /// A bar on stderr counting the blocks the wave has hit; indicatif draws it
@@ -72,6 +75,7 @@ pub fn run() -> i32 {
         Command::Chain(args) => chain::run(args),
         Command::Paper(args) => paper::run_cmd(args),
         Command::Bench(args) => bench::run(args),
+        Command::Stress(args) => stress::run(args),
     };
     match result {
         Ok(()) => 0,

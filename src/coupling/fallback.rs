@@ -93,7 +93,9 @@ pub struct GroupSolver {
 /// rounding (10⁻⁹ relative): the LZB law never creates energy (e ≤ 1,
 /// friction dissipates), so such a result is a failed integration (an
 /// adaptive step far too coarse) and goes to the next stage.
-fn gains_energy(out: &ImpactOutcome) -> bool {
+/// An outcome with more kinetic energy than before, beyond round-off
+/// (10⁻⁹ relative): never accepted from the LZB law.
+pub fn gains_energy(out: &ImpactOutcome) -> bool {
     out.kinetic_energy_after > out.kinetic_energy_before * (1.0 + 1e-9) + f64::MIN_POSITIVE
 }
 
@@ -108,6 +110,21 @@ impl GroupSolver {
     /// Resolves one impact group into `out` by the policy. Errors only for
     /// invalid input, before any stepping.
     pub fn solve_into(
+        &mut self,
+        bodies: &[Body],
+        contacts: &[Contact],
+        settings: &ImpactSettings,
+        policy: &FallbackPolicy,
+        out: &mut ImpactOutcome,
+    ) -> Result<Resolution, ImpactError> {
+        let how = self.by_policy(bodies, contacts, settings, policy, out);
+        if how.is_ok() {
+            crate::impact::audit::record(bodies, contacts, out);
+        }
+        how
+    }
+
+    fn by_policy(
         &mut self,
         bodies: &[Body],
         contacts: &[Contact],

@@ -7,6 +7,7 @@
 //! | [`ImpactSettings`], [`StepControl`] | the paper's fixed impulse step, or adaptive stepping with an error tolerance |
 //! | [`ImpactSolver`] | reusable solver (keeps its buffers between impacts) |
 //! | [`ImpactOutcome`] | velocities, impulses, peak energies, kinetic energy before/after, steps |
+//! | [`audit`] | an independent per-thread check of every accepted impact (the stress sweep) |
 //!
 //! The model (paper Sec. 2.3 with the corrections of docs/model.md §1–4):
 //! positions are frozen and non-impulsive forces ignored during the impact; the
@@ -26,6 +27,7 @@
 //! assert!((out.bodies[0].velocity[0] + 1.0).abs() < 1e-3);
 //! ```
 
+pub mod audit;
 mod body;
 mod contact;
 mod error;

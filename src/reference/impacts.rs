@@ -259,7 +259,12 @@ impl Engine {
         let mut result =
             self.solver
                 .solve_into(&buf.bodies, &buf.contacts, &first, &mut buf.outcome);
-        if step_limit(&result) && can_hold {
+        // an outcome that created energy is not accepted (the same rule as
+        // the Rapier adapter's fallback policy, `coupling::fallback`)
+        let gained = |r: &Result<(), _>, out: &crate::impact::ImpactOutcome| {
+            r.is_ok() && crate::coupling::gains_energy(out)
+        };
+        if (step_limit(&result) || gained(&result, &buf.outcome)) && can_hold {
             // The paper's e = 0 law did not finish: a wedged group whose e = 0
             // contacts release and reload in ever smaller cycles. Their limit
             // is a contact held closed, which `e0_hold` solves directly (the
@@ -271,11 +276,15 @@ impl Engine {
             result = self
                 .solver
                 .solve_into(&buf.bodies, &buf.contacts, &held, &mut buf.outcome);
-            if result.is_ok() {
+            if result.is_ok() && !gained(&result, &buf.outcome) {
                 self.held_impacts += 1;
             }
         }
         match result {
+            Ok(()) if gained(&result, &buf.outcome) => {
+                self.plastic_impact(buf);
+                return Ok(true);
+            }
             Ok(()) => {}
             Err(_) if step_limit(&result) => {
                 // Still unfinished: resolve this one as a plastic impact, the
@@ -293,6 +302,7 @@ impl Engine {
             }
         }
         let out = &buf.outcome;
+        crate::impact::audit::record(&buf.bodies, &buf.contacts, out);
         self.impacts += 1;
         self.energy.impacts += out.kinetic_energy_before - out.kinetic_energy_after;
         for (k, &i) in buf.members.iter().enumerate() {

@@ -171,7 +171,7 @@ fn law(at: &str, l: &PairLaw) -> Result<(), InputError> {
 
 /// A body's shape placed in the plane, for the overlap test.
 #[derive(Clone, Copy, Debug)]
-struct Placed {
+pub(crate) struct Placed {
     index: usize,
     centre: [f64; 2],
     angle: f64,
@@ -266,6 +266,19 @@ fn ball_box(ball: &Placed, bx: &Placed) -> f64 {
     let outside = q[0].max(0.0).hypot(q[1].max(0.0));
     let inside = q[0].max(q[1]).min(0.0);
     ball.half[0] - (outside + inside)
+}
+
+/// Depth (m) by which two boxes (centre, angle, half extents) overlap, ≤ 0
+/// when they do not (the stress sweep's penetration check).
+pub(crate) fn box_overlap(a: ([f64; 2], f64), b: ([f64; 2], f64), half: [f64; 2]) -> f64 {
+    let placed = |(centre, angle): ([f64; 2], f64)| Placed {
+        index: 0,
+        centre,
+        angle,
+        half,
+        ball: false,
+    };
+    box_box(&placed(a), &placed(b))
 }
 
 /// Box against box by separating axes: the least overlap of their

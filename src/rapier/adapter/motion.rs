@@ -148,6 +148,22 @@ impl Motion {
         }
     }
 
+    /// Records body `h` too if it is dynamic, awake and not recorded yet: a
+    /// body added since the last step, which Rapier's island manager lists
+    /// only after that step.
+    pub fn record_added(&mut self, bodies: &RigidBodySet, h: RigidBodyHandle) {
+        if self.start_of.get(index(h)).is_some_and(|&s| s != NONE) {
+            return;
+        }
+        let Some(rb) = bodies.get(h) else { return };
+        if !rb.is_dynamic() || rb.is_sleeping() {
+            return;
+        }
+        let (com, angle) = com_and_angle(rb);
+        *slot(&mut self.start_of, index(h)) = self.starts.len() as u32;
+        self.starts.push((h, com, angle));
+    }
+
     /// Forgets the paths of the last pass; `dt` is the new step's length (s).
     pub fn begin_pass(&mut self, dt: Real) {
         self.reset(f64::from(dt), false);

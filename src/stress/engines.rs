@@ -1,0 +1,231 @@
+//! One combination through its engine, observed step by step.
+
+use std::time::Instant;
+
+use super::combo::{Combo, SplitMix64, StressEngine};
+use super::observe::{Observation, RowWatch};
+use crate::coupling::{FallbackPolicy, GroupSolver};
+use crate::impact::{audit, Body, Contact, ContactMaterial, ImpactOutcome, ImpactSettings};
+use crate::rapier::scene::{row_scene, Engine, SolverSpec};
+use crate::reference::{Integrator, Settings};
+
+/// Simulated time (s) a row gets: 4 t̄ per block and 2 s, far beyond the
+/// slowest wave the sweep draws (about 1.2 t̄ per block at push 0.5).
+fn sim_time(c: &Combo) -> f64 {
+    2.0 + 4.0 * c.row.n as f64 * c.row.params.time_scale()
+}
+
+/// Runs `c` with every impact checked; `budget` is the wall-clock budget (s).
+pub fn run_combo(c: &Combo, budget: f64) -> Observation {
+    audit::start();
+    let start = Instant::now();
+    let mut seen = match c.engine {
+        StressEngine::Reference => reference(c, budget),
+        StressEngine::RapierF64 => rapier_f64(c, Engine::Rapier, budget),
+        StressEngine::RapierF32 => rapier_f32(c, Engine::Rapier, budget),
+        StressEngine::Native => rapier_f64(c, Engine::RapierNative, budget),
+        StressEngine::Impact => free_impact(c),
+    };
+    seen.wall = start.elapsed().as_secs_f64();
+    seen.over_budget |= seen.wall > budget;
+    seen.audit = audit::finish();
+    seen
+}
+
+/// The reference engine with heel contacts (no overlap where blocks slide
+/// back, `Settings::heel_contacts`), observed through snapshots every 2 ms,
+/// up to the last block's hit: the wave its contact set models. (After it,
+/// in the pile of fallen blocks, a block whose top has passed the top of the
+/// block ahead would need that block's corner on its face, a contact the
+/// reference does not have: the sweep found blocks sliding through each
+/// other there, `docs/stress.md`.)
+fn reference(c: &Combo, budget: f64) -> Observation {
+    let t_end = sim_time(c);
+    let settings = Settings {
+        integrator: Integrator::Paper { dt: c.dt },
+        heel_contacts: true,
+        stop_at_last_hit: true,
+        wall_time_limit: Some(budget),
+        t_max: Some(t_end),
+        snapshot_times: (1..)
+            .map(|k| k as f64 * 2e-3)
+            .take_while(|t| *t < t_end)
+            .collect(),
+        ..Settings::default()
+    };
+    let b = c.row.params.block;
+    let mut watch = RowWatch::new(b.height, b.thickness);
+    match crate::reference::run(&c.row, &settings) {
+        Ok(out) => {
+            for s in &out.snapshots {
+                // the reference's y is the centre height; φ counter-clockwise
+                watch.look(&s.blocks);
+            }
+            let r = &out.report;
+            watch.seen.hits = r.hit_times.len();
+            watch.seen.over_budget = r.stopped_early;
+            let energy_finite = r.energy.is_none_or(|e| {
+                [e.initial, e.kinetic, e.potential, e.impacts, e.friction]
+                    .iter()
+                    .all(|v| v.is_finite())
+            });
+            if !energy_finite || r.hit_times.iter().any(|t| !t.is_finite()) {
+                watch.seen.non_finite = true;
+            }
+        }
+        Err(e) => watch.seen.error = Some(e.to_string()),
+    }
+    watch.seen
+}
+
+macro_rules! rapier_runner {
+    ($name:ident, $adapter:ident, $backend:ident) => {
+        /// A Rapier build of the row, its blocks perturbed, observed after
+        /// every step.
+        fn $name(c: &Combo, engine: Engine, budget: f64) -> Observation {
+            use crate::rapier::$adapter as adapter;
+            use crate::$backend::math::{Pose, Real, Vector};
+            let t_end = sim_time(c);
+            let solver = SolverSpec {
+                dt: c.dt,
+                ..SolverSpec::default()
+            };
+            let scene = row_scene(&c.row, solver, t_end);
+            let b = c.row.params.block;
+            let mut watch = RowWatch::new(b.height, b.thickness);
+            let mut sw = match adapter::build(&scene, engine) {
+                Ok(sw) => sw,
+                Err(e) => {
+                    watch.seen.error = Some(format!("{e:#}"));
+                    return watch.seen;
+                }
+            };
+            let Some(row) = sw.row.clone() else {
+                watch.seen.error = Some("the scene has no row".into());
+                return watch.seen;
+            };
+            let handles: Vec<_> = row
+                .colliders
+                .iter()
+                .filter_map(|c| sw.world.colliders[*c].parent())
+                .collect();
+            // perturb blocks 2..n: shift in x, tilt forward about the front
+            // bottom edge (the back corner lifts: no overlap with the ground)
+            for (k, h) in handles.iter().enumerate().skip(1) {
+                let (dx, tilt) = c.perturbation[k];
+                let rb = &mut sw.world.bodies[*h];
+                let p = rb.position();
+                let (x, y) = (f64::from(p.translation.x), f64::from(p.translation.y));
+                let pivot = [x + 0.5 * b.thickness, y - 0.5 * b.height];
+                let r = [x - pivot[0], y - pivot[1]];
+                let (s, co) = (-tilt).sin_cos();
+                let centre = [
+                    pivot[0] + co * r[0] - s * r[1] + dx,
+                    pivot[1] + s * r[0] + co * r[1],
+                ];
+                let pose = Pose::new(
+                    Vector::new(centre[0] as Real, centre[1] as Real),
+                    (-tilt) as Real,
+                );
+                rb.set_position(pose, true);
+            }
+            let start = Instant::now();
+            let dt = f64::from(sw.world.integration_parameters.dt);
+            let mut hits = adapter::HitTracker::new();
+            let mut blocks = vec![[0.0; 3]; handles.len()];
+            while sw.time < t_end {
+                sw.step();
+                hits.update(&sw, sw.time, dt);
+                for (k, h) in handles.iter().enumerate() {
+                    let p = sw.world.bodies[*h].position();
+                    blocks[k] = [
+                        f64::from(p.translation.x),
+                        f64::from(p.translation.y),
+                        f64::from(p.rotation.angle()),
+                    ];
+                }
+                watch.look(&blocks);
+                if watch.seen.non_finite {
+                    break;
+                }
+                if start.elapsed().as_secs_f64() > budget {
+                    watch.seen.over_budget = true;
+                    break;
+                }
+                let quiet = sw.time - hits.hit_times.last().copied().unwrap_or(0.0) > 2.0;
+                if hits.hit_times.len() >= c.row.n && quiet {
+                    break;
+                }
+                if quiet && sw.kinetic_energy() < 1e-12 {
+                    break;
+                }
+            }
+            watch.seen.hits = hits.hit_times.len();
+            watch.seen
+        }
+    };
+}
+
+rapier_runner!(rapier_f64, f64, rapier2d_f64);
+rapier_runner!(rapier_f32, f32, rapier2d);
+
+/// A free-body impact: a chain of 2 to 6 balls or boxes in a line, touching,
+/// struck at one end, every contact elastic (e = 1) and frictionless in half
+/// the draws; through the resolver with the engines' fallback policy.
+fn free_impact(c: &Combo) -> Observation {
+    let mut g = SplitMix64::new(c.impact_seed);
+    let n = 2 + (g.next_u64() % 5) as usize;
+    let elastic = g.unit() < 0.5;
+    let mut bodies = Vec::with_capacity(n);
+    let mut contacts = Vec::with_capacity(n);
+    let mut x = 0.0;
+    let dir = g.range(0.0, std::f64::consts::TAU);
+    let axis = [dir.cos(), dir.sin()];
+    for k in 0..n {
+        let r = g.range(0.02, 0.1);
+        let m = g.range(0.1, 10.0);
+        let i = 0.4 * m * r * r * g.range(0.5, 2.0);
+        if k > 0 {
+            x += r;
+        }
+        let mut b = Body::new(m, i).with_position([x * axis[0], x * axis[1]]);
+        if k == 0 {
+            let speed = 10f64.powf(g.range(-3.0, 2.0));
+            b = b.with_velocity([
+                speed * (axis[0] + g.range(-0.2, 0.2)),
+                speed * (axis[1] + g.range(-0.2, 0.2)),
+            ]);
+            b.angular_velocity = g.range(-1.0, 1.0) * speed / r;
+        }
+        bodies.push(b);
+        if k + 1 < n {
+            let mut mat = ContactMaterial::hertz(10f64.powf(g.range(6.0, 11.0)));
+            if !elastic {
+                mat = mat.with_restitution(g.pick(&[0.0, 0.5, 0.9]));
+                mat.friction = g.range(0.0, 0.6);
+                mat.stick_friction = mat.friction * g.range(1.0, 1.2);
+            }
+            let p = x + r;
+            contacts.push(Contact::new(
+                [Some(k), Some(k + 1)],
+                [p * axis[0], p * axis[1]],
+                axis,
+                mat,
+            ));
+            x = p;
+        }
+    }
+    let mut out = ImpactOutcome::default();
+    let mut seen = Observation::default();
+    let r = GroupSolver::default().solve_into(
+        &bodies,
+        &contacts,
+        &ImpactSettings::default(),
+        &FallbackPolicy::default(),
+        &mut out,
+    );
+    if let Err(e) = r {
+        seen.error = Some(e.to_string());
+    }
+    seen
+}

@@ -1,0 +1,100 @@
+//! The stress sweep's checks fail where they should: an outcome that
+//! creates energy, velocities that do not follow from the impulses, a lost
+//! momentum, overlapping blocks, a fallen block standing up again; and a
+//! few combinations of every engine pass.
+
+use topple::impact::audit::{check, AuditSummary};
+use topple::impact::{Body, BodyVelocity, Contact, ContactImpulse, ContactMaterial, ImpactOutcome};
+use topple::stress::{draw, run_combo, violations, RowWatch, StressEngine};
+
+/// Two equal balls (m = 1 kg, r = 0.1 m) in line, the first at 1 m/s.
+fn pair() -> (Vec<Body>, Vec<Contact>) {
+    let bodies = vec![
+        Body::new(1.0, 0.004).with_velocity([1.0, 0.0]),
+        Body::new(1.0, 0.004).with_position([0.2, 0.0]),
+    ];
+    let contacts = vec![Contact::new(
+        [Some(0), Some(1)],
+        [0.1, 0.0],
+        [1.0, 0.0],
+        ContactMaterial::hertz(1e8),
+    )];
+    (bodies, contacts)
+}
+
+fn outcome(v0: f64, v1: f64, impulse: f64) -> ImpactOutcome {
+    let vel = |v: f64| BodyVelocity {
+        velocity: [v, 0.0],
+        angular_velocity: 0.0,
+    };
+    ImpactOutcome {
+        bodies: vec![vel(v0), vel(v1)],
+        contacts: vec![ContactImpulse {
+            normal_impulse: impulse,
+            tangent_impulse: 0.0,
+            peak_energy: 0.0,
+        }],
+        ..ImpactOutcome::default()
+    }
+}
+
+#[test]
+fn the_elastic_exchange_passes_every_impact_check() {
+    // Newton's cradle of two: the velocities swap, impulse 1 N s
+    let (b, c) = pair();
+    let mut s = AuditSummary::default();
+    check(&b, &c, &outcome(0.0, 1.0, 1.0), &mut s);
+    assert_eq!(s.elastic_impacts, 1);
+    assert!(s.energy_gain <= 0.0 && s.elastic_energy < 1e-15 && s.momentum < 1e-15);
+    assert!(s.consistency < 1e-15);
+}
+
+#[test]
+fn energy_creation_momentum_loss_and_wrong_velocities_are_caught() {
+    let (b, c) = pair();
+    // second ball leaves at 1.2 m/s with impulse 1.2: ½(0.04 + 1.44) = 0.74 J > 0.5 J
+    let mut s = AuditSummary::default();
+    check(&b, &c, &outcome(-0.2, 1.2, 1.2), &mut s);
+    assert!((s.energy_gain - 0.48).abs() < 1e-12, "{s:?}");
+    // velocities that the impulse does not give: momentum 1.5 instead of 1
+    let mut s = AuditSummary::default();
+    check(&b, &c, &outcome(0.5, 1.0, 1.0), &mut s);
+    assert!(s.momentum > 0.4 && s.consistency > 0.4, "{s:?}");
+    // a NaN
+    let mut s = AuditSummary::default();
+    check(&b, &c, &outcome(f64::NAN, 1.0, 1.0), &mut s);
+    assert_eq!(s.non_finite, 1);
+}
+
+#[test]
+fn overlap_and_a_fallen_block_standing_up_are_seen() {
+    // blocks 0.1 m × 0.02 m, the second 5 mm into the first
+    let mut w = RowWatch::new(0.1, 0.02);
+    w.look(&[[0.0, 0.05, 0.0], [0.015, 0.05, 0.0]]);
+    assert!((w.seen.penetration - 0.05).abs() < 1e-12, "{:?}", w.seen);
+    // a block 1 cm into the ground
+    let mut w = RowWatch::new(0.1, 0.02);
+    w.look(&[[0.0, 0.04, 0.0]]);
+    assert!((w.seen.penetration - 0.1).abs() < 1e-12);
+    // fallen (tilt 1 rad > π/4), then upright again
+    let mut w = RowWatch::new(0.1, 0.02);
+    w.look(&[[0.0, 0.05, -1.0]]);
+    w.look(&[[0.0, 0.05, 0.0]]);
+    assert_eq!(w.seen.fallen_drop, 1);
+    let mut w = RowWatch::new(0.1, 0.02);
+    w.look(&[[0.0, f64::NAN, 0.0]]);
+    assert!(w.seen.non_finite);
+}
+
+#[test]
+fn a_few_combinations_of_every_engine_pass() {
+    for index in 0..10 {
+        let c = draw(7, index, 3, 5);
+        let o = run_combo(&c, 60.0);
+        let v = violations(&c, &o);
+        assert!(v.is_empty(), "{:?}: {v:?}", c.engine);
+        if c.engine != StressEngine::Impact {
+            assert!(o.hits >= 1, "{:?}", o);
+        }
+    }
+}
