@@ -26,9 +26,9 @@ mod scene;
 pub use impact::impact;
 pub use memory::{available_memory, check_memory, memory_estimate, EngineKind};
 pub use row::{row, Naming, RunBudget};
+pub(crate) use scene::box_overlap;
 #[cfg(feature = "scene-files")]
 pub use scene::parse_toml;
-pub(crate) use scene::box_overlap;
 pub use scene::{scene, SyntaxError};
 
 /// A value outside its allowed range: the field, the value as given and the
