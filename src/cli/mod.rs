@@ -10,6 +10,7 @@ mod chain;
 mod impact;
 mod paper;
 mod plot;
+mod resume;
 mod scene;
 mod stress;
 mod theory;

@@ -38,6 +38,11 @@ pub struct Args {
     /// measured and is reported on stderr.
     #[arg(long, allow_hyphen_values = true, default_value_t = 120.0)]
     pub run_limit: f64,
+    /// Reuse the runs an earlier (interrupted) call saved in OUT/runs/ when
+    /// their row and settings match exactly; every finished run is saved
+    /// there as it ends.
+    #[arg(long)]
+    pub resume: bool,
 }
 
 struct Job {
@@ -312,16 +317,41 @@ pub fn run_cmd(args: Args) -> anyhow::Result<()> {
         ProgressStyle::with_template("{bar:40} {pos}/{len} runs, {elapsed} elapsed, eta {eta}")
             .unwrap_or_else(|_| ProgressStyle::default_bar()),
     );
+    let store = super::resume::RunStore::new(&args.out);
+    let reused = std::sync::atomic::AtomicUsize::new(0);
     let results: Vec<Result<ChainReport, String>> = jobs
         .par_iter()
         .map(|j| {
+            if args.resume {
+                if let Some(r) = store.load(&j.row, &j.settings) {
+                    reused.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+                    bar.inc(1);
+                    return Ok(r);
+                }
+            }
             let r = run(&j.row, &j.settings)
                 .map(|o| o.report)
                 .map_err(|e| format!("fig {} {} x={}: {e}", j.fig, j.key, j.x));
+            if let Ok(report) = &r {
+                // a run cut by its wall-clock limit is not kept for reuse
+                if !report.stopped_early {
+                    if let Err(e) = store.save(&j.row, &j.settings, report) {
+                        eprintln!("warning: could not save a finished run: {e:#}");
+                    }
+                }
+            }
             bar.inc(1);
             r
         })
         .collect();
+    if args.resume {
+        eprintln!(
+            "reused {} of {} runs saved in {}",
+            reused.into_inner(),
+            jobs.len(),
+            args.out.join("runs").display()
+        );
+    }
     bar.finish();
     for (j, r) in jobs.iter().zip(results.iter()) {
         match r {
