@@ -81,19 +81,21 @@ const GROUND_MU1: f64 = 0.15;
 
 /// The rows of `fig5_ground`: the ideal Domino T row with μ1 = 0 and 0.15,
 /// each on a no-slip ground, with the paper's halved impact friction and
-/// with full impact friction (μ2 = 0.9 in and out of impacts).
+/// with full impact friction (μ2 = 0.9 in and out of impacts). The no-slip
+/// rows keep μ1 at full value inside impacts too, as the extended model
+/// assumes. Curve names hold no commas (they go into a CSV header).
 fn ground_variants() -> Vec<(String, RowParams)> {
     let ideal = Preset::T.params().ideal();
     let mut v = Vec::new();
     for mu1 in [0.0, GROUND_MU1] {
         let p = set_mu1(ideal, mu1);
-        let mut no_slip = p;
-        no_slip.ground = Ground::NoSlip;
         let mut full = p;
         full.impact_friction_factor = 1.0;
-        v.push((format!("no-slip, mu1 = {mu1}"), no_slip));
-        v.push((format!("halved impact friction, mu1 = {mu1}"), p));
-        v.push((format!("full impact friction, mu1 = {mu1}"), full));
+        let mut no_slip = full;
+        no_slip.ground = Ground::NoSlip;
+        v.push((format!("no-slip ground; mu1 = {mu1}"), no_slip));
+        v.push((format!("halved impact friction; mu1 = {mu1}"), p));
+        v.push((format!("full impact friction; mu1 = {mu1}"), full));
     }
     v
 }
@@ -519,12 +521,15 @@ pub fn run_cmd(args: Args) -> anyhow::Result<()> {
                 name: "cooperative (mu = 0)".into(),
                 model: Model::Cooperative,
                 style: Style::Line,
+                // grey: the six point colours include black and blue
+                colour: RGBColor(120, 120, 120),
                 ..lines[0].clone()
             },
             TheoryLine {
                 name: format!("extended (mu = {mu})"),
                 model: Model::Extended { mu },
                 style: Style::Dashed,
+                colour: RGBColor(120, 120, 120),
                 ..lines[1].clone()
             },
         ];
