@@ -148,12 +148,24 @@ fn draw(
         .y_label_area_size(56)
         .build_cartesian_2d(x0..x1, y0..y1)
         .map_err(|e| anyhow::anyhow!("{e}"))?;
-    chart
-        .configure_mesh()
-        .x_desc(xlabel)
-        .y_desc(ylabel)
-        .draw()
-        .map_err(|e| anyhow::anyhow!("{e}"))?;
+    // block numbers and other integer abscissae get integer tick labels only
+    let integer_x = curves
+        .iter()
+        .flat_map(|c| c.points.iter())
+        .all(|p| !p.0.is_finite() || p.0.fract() == 0.0);
+    let integer_tick = |x: &f64| {
+        if (x - x.round()).abs() < 1e-9 {
+            format!("{}", x.round())
+        } else {
+            String::new()
+        }
+    };
+    let mut mesh = chart.configure_mesh();
+    mesh.x_desc(xlabel).y_desc(ylabel);
+    if integer_x {
+        mesh.x_label_formatter(&integer_tick);
+    }
+    mesh.draw().map_err(|e| anyhow::anyhow!("{e}"))?;
     for (k, c) in curves.iter().enumerate() {
         let col = c.colour.unwrap_or(COLOURS[k % COLOURS.len()]);
         // contiguous runs of finite points: a non-finite y (no value) breaks a line

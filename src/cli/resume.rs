@@ -40,6 +40,11 @@ impl RunStore {
         }
     }
 
+    /// The directory the runs are saved in.
+    pub fn dir(&self) -> &Path {
+        &self.dir
+    }
+
     fn path(&self, row: &RowSpec, settings: &Settings) -> PathBuf {
         let key = serde_json::to_string(&(row, settings)).unwrap_or_default();
         self.dir.join(format!("{:016x}.json", fnv1a(&key)))
