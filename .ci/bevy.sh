@@ -31,7 +31,7 @@ echo "headless_row (topple and native, ideal Domino T, s/h 0.45, 1/60 s)"
 
 echo "dominoes --screenshot under Xvfb"
 timeout 300 xvfb-run -a -s "-screen 0 1280x720x24" \
-    ./target/release/examples/dominoes --screenshot "$out/dominoes.png" --frames 90
+    ./target/release/examples/dominoes --screenshot "$out/dominoes.png" --frames 50
 python3 .ci/check_screenshot.py "$out/dominoes.png"
 
 echo "cradle --screenshot under Xvfb"

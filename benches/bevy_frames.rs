@@ -8,11 +8,15 @@
 //! ```
 //!
 //! Prints per case the mean and worst frame time, the real-time factor
-//! (simulated over wall time) and topple's cost over native's.
+//! (simulated over wall time) and topple's cost over native's, for topple's
+//! default settings (a frame taken as four 1/240 s pieces) and for whole
+//! 1/60 s steps (`ToppleSettings::max_substep = None`).
 
 use std::time::Instant;
 
-use topple::bevy::{headless_row_app, DominoRow, DominoRowState, RowPhysics, ToppleFrameStats};
+use topple::bevy::{
+    headless_row_app, DominoRow, DominoRowState, RowPhysics, ToppleConfig, ToppleFrameStats,
+};
 use topple::domino::{Preset, RowSpec};
 
 const DT: f64 = 1.0 / 60.0;
@@ -26,13 +30,19 @@ struct Case {
     impacts: u64,
 }
 
-fn run(n: usize, physics: RowPhysics) -> Case {
+fn run(n: usize, physics: RowPhysics, substeps: bool) -> Case {
     let p = Preset::T.params().ideal();
     let row = DominoRow {
         physics,
         ..DominoRow::new(RowSpec::new(p, 0.45 * p.block.height, n, 1.0))
     };
     let (mut app, id) = headless_row_app(&row, DT).expect("a valid row");
+    if !substeps {
+        app.world_mut()
+            .resource_mut::<ToppleConfig>()
+            .settings
+            .max_substep = None;
+    }
     let (mut worst, mut impacts) = (0.0f64, 0);
     let start = Instant::now();
     for _ in 0..FRAMES {
@@ -42,7 +52,12 @@ fn run(n: usize, physics: RowPhysics) -> Case {
         impacts += app.world().resource::<ToppleFrameStats>().impacts;
     }
     let wall = start.elapsed().as_secs_f64();
-    let hit = app.world().get::<DominoRowState>(id).unwrap().hit_times().len();
+    let hit = app
+        .world()
+        .get::<DominoRowState>(id)
+        .unwrap()
+        .hit_times()
+        .len();
     Case {
         mean_ms: 1e3 * wall / FRAMES as f64,
         worst_ms: 1e3 * worst,
@@ -56,9 +71,14 @@ fn main() {
     println!("| blocks | engine | mean frame (ms) | worst frame (ms) | × real time | blocks hit | impacts | topple / native |");
     println!("| --- | --- | --- | --- | --- | --- | --- | --- |");
     for n in [1_000, 10_000] {
-        let native = run(n, RowPhysics::Native);
-        let topple = run(n, RowPhysics::Topple);
-        for (name, c) in [("native", &native), ("topple", &topple)] {
+        let native = run(n, RowPhysics::Native, false);
+        let topple = run(n, RowPhysics::Topple, true);
+        let whole = run(n, RowPhysics::Topple, false);
+        for (name, c) in [
+            ("native", &native),
+            ("topple (1/240 s pieces, default)", &topple),
+            ("topple (whole 1/60 s steps)", &whole),
+        ] {
             println!(
                 "| {n} | {name} | {:.3} | {:.2} | {:.0} | {} | {} | {} |",
                 c.mean_ms,
@@ -66,8 +86,8 @@ fn main() {
                 c.realtime,
                 c.hit,
                 c.impacts,
-                if name == "topple" {
-                    format!("{:.2}", topple.mean_ms / native.mean_ms)
+                if name != "native" {
+                    format!("{:.2}", c.mean_ms / native.mean_ms)
                 } else {
                     "".into()
                 }

@@ -24,8 +24,11 @@ const RADIUS: f32 = 0.02;
 const STRING: f32 = 0.2;
 const MASS: f32 = 0.26;
 const BALLS: usize = 5;
-const LIFT: f32 = 0.5236; // 30°
+/// The first ball starts raised by 30°.
+const LIFT: f32 = std::f32::consts::FRAC_PI_6;
 const G: f32 = 9.81;
+/// Rest height of the balls of the native and the topple cradle (m).
+const REST_Y: [f32; 2] = [0.02, -0.26];
 
 #[derive(Component)]
 struct Ball {
@@ -34,6 +37,40 @@ struct Ball {
 
 #[derive(Component)]
 struct Hud;
+
+/// A string from a pivot (m) to a ball, drawn as a thin rectangle.
+#[derive(Component)]
+struct StringTo {
+    pivot: Vec2,
+    ball: Entity,
+}
+
+/// A white disc on a transparent square, tinted by each ball's sprite.
+fn disc_image() -> Image {
+    use bevy::asset::RenderAssetUsages;
+    use bevy::render::render_resource::{Extent3d, TextureDimension, TextureFormat};
+    const SIZE: u32 = 64;
+    let mut data = Vec::with_capacity((SIZE * SIZE * 4) as usize);
+    for y in 0..SIZE {
+        for x in 0..SIZE {
+            let (dx, dy) = (x as f32 + 0.5 - 32.0, y as f32 + 0.5 - 32.0);
+            // coverage of the pixel by the disc of radius 31.5, one pixel of ramp
+            let alpha = (31.5 - (dx * dx + dy * dy).sqrt() + 0.5).clamp(0.0, 1.0);
+            data.extend_from_slice(&[255, 255, 255, (alpha * 255.0) as u8]);
+        }
+    }
+    Image::new(
+        Extent3d {
+            width: SIZE,
+            height: SIZE,
+            depth_or_array_layers: 1,
+        },
+        TextureDimension::D2,
+        data,
+        TextureFormat::Rgba8UnormSrgb,
+        RenderAssetUsages::RENDER_WORLD,
+    )
+}
 
 #[derive(Resource)]
 struct Run {
@@ -75,7 +112,10 @@ fn main() -> AppExit {
             ..default()
         }))
         .add_plugins((rapier_plugin(), TopplePlugin::default()))
-        .insert_resource(TimestepMode::Fixed { dt: DT, substeps: 1 })
+        .insert_resource(TimestepMode::Fixed {
+            dt: DT,
+            substeps: 1,
+        })
         .insert_resource(ClearColor(Color::srgb(0.08, 0.08, 0.1)))
         .insert_resource(Run {
             frame: 0,
@@ -83,11 +123,12 @@ fn main() -> AppExit {
             start_energy: [0.0; 2],
         })
         .add_systems(Startup, setup)
-        .add_systems(Update, (hud, finish).chain())
+        .add_systems(Update, (strings, hud, finish).chain())
         .run()
 }
 
-fn setup(mut commands: Commands) {
+fn setup(mut commands: Commands, mut images: ResMut<Assets<Image>>) {
+    let disc = images.add(disc_image());
     commands.spawn((
         Camera2d,
         Projection::Orthographic(OrthographicProjection {
@@ -108,12 +149,15 @@ fn setup(mut commands: Commands) {
         impact: ContactMaterial::hertz(1.0e10).with_restitution(1.0),
         smooth_friction: 0.0,
     });
-    for (topple, y) in [(false, 0.14), (true, -0.16)] {
+    for (topple, y) in [(false, REST_Y[0]), (true, REST_Y[1])] {
         for i in 0..BALLS {
             let pivot = Vec2::new((i as f32 - 2.0) * 2.0 * RADIUS, y + STRING);
             let angle = if i == 0 { -LIFT } else { 0.0 };
             let centre = pivot + STRING * Vec2::new(angle.sin(), -angle.cos());
-            let mut anchor = commands.spawn((RigidBody::Fixed, Transform::from_translation(pivot.extend(0.0))));
+            let mut anchor = commands.spawn((
+                RigidBody::Fixed,
+                Transform::from_translation(pivot.extend(0.0)),
+            ));
             if !topple {
                 anchor.insert(RapierContextEntityLink(native));
             }
@@ -130,11 +174,18 @@ fn setup(mut commands: Commands) {
                     .with_rotation(Quat::from_rotation_z(angle)),
                 Velocity::zero(),
                 ImpulseJoint::new(anchor, joint),
-                Sprite::from_color(
-                    if topple { Color::srgb(0.95, 0.55, 0.15) } else { Color::srgb(0.25, 0.55, 0.95) },
-                    Vec2::splat(2.0 * RADIUS),
-                ),
+                Sprite {
+                    image: disc.clone(),
+                    color: if topple {
+                        Color::srgb(0.95, 0.55, 0.15)
+                    } else {
+                        Color::srgb(0.25, 0.55, 0.95)
+                    },
+                    custom_size: Some(Vec2::splat(2.0 * RADIUS)),
+                    ..default()
+                },
             ));
+            let ball_id = ball.id();
             if topple {
                 ball.insert(steel);
             } else {
@@ -144,17 +195,39 @@ fn setup(mut commands: Commands) {
                     Friction::coefficient(0.0),
                 ));
             }
+            commands.spawn((
+                StringTo {
+                    pivot,
+                    ball: ball_id,
+                },
+                Sprite::from_color(Color::srgb(0.6, 0.6, 0.6), Vec2::new(0.001, STRING)),
+                Transform::from_translation(pivot.extend(-1.0)),
+            ));
         }
     }
     commands.spawn((
         Hud,
         Text2d::new(""),
         TextFont {
-            font_size: 18.0,
+            font_size: FontSize::Px(18.0),
             ..default()
         },
-        Transform::from_xyz(0.0, 0.24, 1.0).with_scale(Vec3::splat(0.0008)),
+        Transform::from_xyz(0.0, 0.255, 1.0).with_scale(Vec3::splat(0.0008)),
     ));
+}
+
+/// Each string from its pivot to its ball's centre.
+fn strings(
+    mut strings: Query<(&StringTo, &mut Transform), Without<Ball>>,
+    balls: Query<&Transform, With<Ball>>,
+) {
+    for (s, mut t) in &mut strings {
+        if let Ok(ball) = balls.get(s.ball) {
+            let d = ball.translation.truncate() - s.pivot;
+            t.translation = (s.pivot + 0.5 * d).extend(-1.0);
+            t.rotation = Quat::from_rotation_z(d.to_angle() + std::f32::consts::FRAC_PI_2);
+        }
+    }
 }
 
 /// Kinetic plus potential energy of each cradle (J; balls as discs).
@@ -183,7 +256,7 @@ fn hud(
         return;
     };
     // energy above the balls' rest height, relative to the start
-    let rest = [0.14, -0.16].map(|y| BALLS as f32 * MASS * G * y);
+    let rest = REST_Y.map(|y| BALLS as f32 * MASS * G * y);
     let lift = MASS * G * STRING * (1.0 - LIFT.cos());
     let share = |k: usize| 100.0 * (e[k] - rest[k]) / lift;
     text.0 = format!(
@@ -202,9 +275,11 @@ fn finish(mut commands: Commands, run: Res<Run>, mut exit: MessageWriter<AppExit
         commands
             .spawn(Screenshot::primary_window())
             .observe(save_to_disk(file))
-            .observe(|_: On<ScreenshotCaptured>, mut exit: MessageWriter<AppExit>| {
-                exit.write(AppExit::Success);
-            });
+            .observe(
+                |_: On<ScreenshotCaptured>, mut exit: MessageWriter<AppExit>| {
+                    exit.write(AppExit::Success);
+                },
+            );
     } else if run.frame > frames + 120 {
         exit.write(AppExit::from_code(1));
     }

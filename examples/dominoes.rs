@@ -97,7 +97,9 @@ fn parse_args() -> Result<Demo, String> {
             "--preset" => demo.preset = value()?.parse()?,
             "--table1" => demo.ideal = false,
             "--n" => demo.n = value()?.parse().map_err(|e| format!("--n: {e}"))?,
-            other => return Err(format!("unknown flag {other}: --screenshot FILE --frames N --preset x|t|p --table1 --n N")),
+            other => return Err(format!(
+                "unknown flag {other}: --screenshot FILE --frames N --preset x|t|p --table1 --n N"
+            )),
         }
     }
     if !(2..=200).contains(&demo.n) {
@@ -160,26 +162,19 @@ fn setup(mut commands: Commands, mut demo: ResMut<Demo>) {
         Transform::from_xyz(0.0, 0.0, 10.0),
     ));
     let row = DominoRow::new(demo.spec());
-    let ctx = commands
-        .spawn((
-            RapierContextSimulation {
-                integration_parameters: row.integration_parameters(DT),
-                ..default()
-            },
-            row.rapier_configuration(),
-        ))
-        .id();
+    let mut sim = RapierContextSimulation::default();
+    sim.integration_parameters = row.integration_parameters(DT);
+    let ctx = commands.spawn((sim, row.rapier_configuration())).id();
     demo.native_context = Some(ctx);
     commands.spawn((
         Hud,
         Text2d::new(""),
         TextFont {
-            font_size: 18.0,
+            font_size: FontSize::Px(18.0),
             ..default()
         },
         TextColor(GREY),
-        Transform::from_xyz(0.0, 0.26 * HEIGHT as f32 * SCALE, 1.0)
-            .with_scale(Vec3::splat(SCALE)),
+        Transform::from_xyz(0.0, 0.26 * HEIGHT as f32 * SCALE, 1.0).with_scale(Vec3::splat(SCALE)),
     ));
 }
 
@@ -219,10 +214,13 @@ fn decorate(mut commands: Commands, rows: Query<&DominoRowState, Added<DominoRow
         }
         let length = (row.spec.pitch() * row.spec.n as f64 + 2.0 * b.height) as f32;
         // a strip on the ground's top face (the collider is 2 m thick)
-        commands.entity(row.ground).with_child((
-            Sprite::from_color(GROUND, Vec2::new(length, 0.004)),
-            Transform::from_xyz(0.0, 1.0 - 0.002, -1.0),
-        ));
+        commands
+            .entity(row.ground)
+            .insert(Visibility::Visible)
+            .with_child((
+                Sprite::from_color(GROUND, Vec2::new(length, 0.004)),
+                Transform::from_xyz(0.0, 1.0 - 0.002, -1.0),
+            ));
     }
 }
 
@@ -247,7 +245,7 @@ fn hud(demo: Res<Demo>, rows: Query<&DominoRowState>, mut text: Query<&mut Text2
         return;
     };
     let mut lines = vec![format!(
-        "Domino {:?}{}  s/h {:.2}  n {}  dt 1/60 s   cooperative model v̂ = {}",
+        "Domino {:?}{}  s/h {:.2}  n {}  dt 1/60 s   cooperative model v_na = {}",
         demo.preset,
         if demo.ideal { " (ideal)" } else { " (Table 1)" },
         demo.spacing_ratio,
@@ -258,7 +256,7 @@ fn hud(demo: Res<Demo>, rows: Query<&DominoRowState>, mut text: Query<&mut Text2
         if let Ok(row) = rows.get(id) {
             let r = row.report();
             lines.push(format!(
-                "{:>12}: blocks hit {:>3}/{}   v̂_na = {}",
+                "{:>12}: blocks hit {:>3}/{}   v_na = {}",
                 match row.physics {
                     RowPhysics::Native => "native (top)",
                     RowPhysics::Topple => "topple",
@@ -342,9 +340,11 @@ fn screenshot(
         commands
             .spawn(Screenshot::primary_window())
             .observe(save_to_disk(file))
-            .observe(|_: On<ScreenshotCaptured>, mut exit: MessageWriter<AppExit>| {
-                exit.write(AppExit::Success);
-            });
+            .observe(
+                |_: On<ScreenshotCaptured>, mut exit: MessageWriter<AppExit>| {
+                    exit.write(AppExit::Success);
+                },
+            );
     } else if demo.frame > frames + 120 {
         error!("no screenshot after 120 more frames");
         exit.write(AppExit::from_code(1));
@@ -381,7 +381,8 @@ fn rows_json(
         };
         let h = row.spec.params.block.height as f32;
         let (x0, y) = to_px(origin + Vec2::new(-h, 0.85 * h));
-        let (x1, _) = to_px(origin + Vec2::new((row.spec.pitch() * row.spec.n as f64) as f32 + h, 0.0));
+        let (x1, _) =
+            to_px(origin + Vec2::new((row.spec.pitch() * row.spec.n as f64) as f32 + h, 0.0));
         let (_, top) = to_px(origin + Vec2::new(0.0, 1.2 * h));
         let (_, bottom) = to_px(origin + Vec2::new(0.0, -0.001));
         out.push(serde_json::json!({

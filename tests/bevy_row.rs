@@ -29,7 +29,10 @@ fn bevy_row(row: &DominoRow) -> DominoRowState {
 }
 
 fn speed(state: &DominoRowState) -> f64 {
-    state.report().natural_speed.expect("the wave reached the steady blocks")
+    state
+        .report()
+        .natural_speed
+        .expect("the wave reached the steady blocks")
 }
 
 #[test]
@@ -38,7 +41,9 @@ fn topple_row_matches_the_f64_plugin_and_the_reference() {
     let bevy = bevy_row(&DominoRow::new(spec));
     assert!(bevy.finished(), "the wave stopped: {:?}", bevy.hit_times());
     let v_bevy = speed(&bevy);
-    let plugin = RapierRow::new(Engine::Rapier, DT).run(&spec, &mut |_| {}).unwrap();
+    let plugin = RapierRow::new(Engine::Rapier, DT)
+        .run(&spec, &mut |_| {})
+        .unwrap();
     let v_plugin = plugin.natural_speed.unwrap();
     let reference = ReferenceRow::default().run(&spec, &mut |_| {}).unwrap();
     let v_ref = reference.natural_speed.unwrap();
@@ -82,7 +87,12 @@ fn the_same_app_twice_gives_identical_transforms() {
     let poses = || {
         let (mut app, id) = headless_row_app(&row, DT).unwrap();
         step_frames(&mut app, 90);
-        let blocks = app.world().get::<DominoRowState>(id).unwrap().blocks.clone();
+        let blocks = app
+            .world()
+            .get::<DominoRowState>(id)
+            .unwrap()
+            .blocks
+            .clone();
         blocks
             .iter()
             .map(|&e| *app.world().get::<Transform>(e).unwrap())
@@ -90,7 +100,11 @@ fn the_same_app_twice_gives_identical_transforms() {
     };
     let (a, b) = (poses(), poses());
     assert_eq!(a.len(), 15);
-    assert!(a.iter().any(|t| t.rotation.to_euler(EulerRot::ZYX).0.abs() > 0.5), "nothing fell");
+    assert!(
+        a.iter()
+            .any(|t| t.rotation.to_euler(EulerRot::ZYX).0.abs() > 0.5),
+        "nothing fell"
+    );
     assert_eq!(a, b);
 }
 

@@ -8,9 +8,9 @@ use bevy_rapier2d::rapier::prelude::IntegrationParameters;
 use super::events::ToppleImpact;
 use super::world::{PhysicsClock, ToppleConfig, ToppleMaterial};
 use crate::coupling::PairMaterial;
+use crate::coupling::ToppleSettings;
 use crate::domino::{ChainReport, RowSpec};
 use crate::rapier::f32::{integration_parameters, signed_gap, HitTracker};
-use crate::coupling::ToppleSettings;
 use crate::rapier::scene::{
     expand_row, pair_material, row_scene, topple_settings, PairLaw, SolverSpec,
 };
@@ -116,7 +116,9 @@ impl DominoRow {
         (scene.pairs[0].law.clone(), scene.pairs[1].law.clone())
     }
 
-    /// Spawns the ground and the blocks, and an entity carrying
+    /// Spawns the ground and the blocks (all but the pushed one asleep, as a
+    /// row standing at rest is after Rapier's sleep delay: the first contact
+    /// wakes each one), and an entity carrying
     /// [`DominoRowState`] that measures the wave; returns that entity.
     /// A topple row also adds its pair rules to [`ToppleConfig`]. The row
     /// must be valid ([`RowSpec::validate`]); an invalid one is refused with
@@ -162,6 +164,13 @@ impl DominoRow {
                     angular: w as f32,
                 },
             ));
+            if i > 0 {
+                // standing at rest: asleep until the wave wakes it
+                e.insert(Sleeping {
+                    sleeping: true,
+                    ..Sleeping::default()
+                });
+            }
             self.add_material(&mut e, block, &block_law);
             blocks.push(e.id());
         }
@@ -262,10 +271,16 @@ pub(crate) fn track_rows(
         if row.finished() {
             continue;
         }
-        let ctx = row.context.and_then(|c| contexts.get(c).ok().map(|x| (c, x)));
-        let Some((clock, bodies, colliders)) = ctx
-            .map(|(_, (c, b, co, _))| (c, b, co))
-            .or_else(|| contexts.iter().find(|x| x.3).map(|(c, b, co, _)| (c, b, co)))
+        let ctx = row
+            .context
+            .and_then(|c| contexts.get(c).ok().map(|x| (c, x)));
+        let Some((clock, bodies, colliders)) =
+            ctx.map(|(_, (c, b, co, _))| (c, b, co)).or_else(|| {
+                contexts
+                    .iter()
+                    .find(|x| x.3)
+                    .map(|(c, b, co, _)| (c, b, co))
+            })
         else {
             continue;
         };

@@ -11,8 +11,8 @@ use bevy_rapier2d::plugin::context::SimulationToRenderTime;
 use bevy_rapier2d::prelude::*;
 use bevy_rapier2d::rapier::math::Real;
 
-use super::plugin::DefaultContext;
 use super::events::{collect, CollisionCollector, ToppleImpact};
+use super::plugin::DefaultContext;
 use super::world::{PhysicsClock, ToppleConfig, ToppleFrameStats, ToppleMaterial, ToppleWorld};
 use crate::rapier::f32::StepParts;
 use crate::rapier::ToppleStats;
@@ -110,8 +110,17 @@ pub(crate) fn step_contexts(
         totals: ToppleStats::default(),
         ..ToppleFrameStats::default()
     };
-    for (entity, mut sim, mut colliders, mut joints, mut bodies, config, mut s2r, world, mut clock) in
-        contexts.iter_mut()
+    for (
+        entity,
+        mut sim,
+        mut colliders,
+        mut joints,
+        mut bodies,
+        config,
+        mut s2r,
+        world,
+        mut clock,
+    ) in contexts.iter_mut()
     {
         if !config.physics_pipeline_active {
             bodies.propagate_modified_body_positions_to_colliders(&mut colliders);
