@@ -97,9 +97,11 @@ fn parse_args() -> Result<Demo, String> {
             "--preset" => demo.preset = value()?.parse()?,
             "--table1" => demo.ideal = false,
             "--n" => demo.n = value()?.parse().map_err(|e| format!("--n: {e}"))?,
-            other => return Err(format!(
+            other => {
+                return Err(format!(
                 "unknown flag {other}: --screenshot FILE --frames N --preset x|t|p --table1 --n N"
-            )),
+            ))
+            }
         }
     }
     if !(2..=200).contains(&demo.n) {

@@ -23,14 +23,54 @@ fn record(mut impacts: MessageReader<ToppleImpact>, mut seen: ResMut<Seen>) {
     seen.0.extend(impacts.read().cloned());
 }
 
+/// How the app steps physics.
+#[derive(Clone, Copy, Debug)]
+enum Stepping {
+    /// `TimestepMode::Fixed` with this many sub-steps, in `PostUpdate`.
+    Fixed(usize),
+    /// `TimestepMode::Variable`.
+    Variable,
+    /// `TimestepMode::Interpolated`.
+    Interpolated,
+    /// Both plugins in `FixedUpdate` (Bevy's 64 Hz fixed clock).
+    FixedSchedule,
+}
+
 fn cradle(topple: bool) -> (App, Vec<Entity>) {
+    cradle_stepped(topple, Stepping::Fixed(1))
+}
+
+fn cradle_stepped(topple: bool, stepping: Stepping) -> (App, Vec<Entity>) {
     let mut app = App::new();
-    app.add_plugins((MinimalPlugins, TransformPlugin))
-        .add_plugins((rapier_plugin(), TopplePlugin::default()))
-        .insert_resource(TimestepMode::Fixed {
+    app.add_plugins((MinimalPlugins, TransformPlugin));
+    match stepping {
+        Stepping::FixedSchedule => app.add_plugins((
+            rapier_plugin().in_fixed_schedule(),
+            TopplePlugin::default().in_fixed_schedule(),
+        )),
+        _ => app.add_plugins((rapier_plugin(), TopplePlugin::default())),
+    };
+    let mode = match stepping {
+        Stepping::Fixed(substeps) => TimestepMode::Fixed {
             dt: 1.0 / 60.0,
+            substeps,
+        },
+        Stepping::Variable => TimestepMode::Variable {
+            max_dt: 1.0 / 30.0,
+            time_scale: 1.0,
             substeps: 1,
-        })
+        },
+        Stepping::Interpolated => TimestepMode::Interpolated {
+            dt: 1.0 / 60.0,
+            time_scale: 1.0,
+            substeps: 1,
+        },
+        Stepping::FixedSchedule => TimestepMode::Fixed {
+            dt: 1.0 / 64.0,
+            substeps: 1,
+        },
+    };
+    app.insert_resource(mode)
         .insert_resource(TimeUpdateStrategy::ManualDuration(Duration::from_secs_f64(
             1.0 / 60.0,
         )))
@@ -75,6 +115,31 @@ fn momentum_and_energy(app: &App, balls: &[Entity]) -> (f32, f32) {
             e + 0.5 * MASS * v.linear.length_squared(),
         )
     })
+}
+
+#[test]
+fn every_timestep_mode_steps_the_cradle_with_topple() {
+    for stepping in [
+        Stepping::Fixed(3),
+        Stepping::Variable,
+        Stepping::Interpolated,
+        Stepping::FixedSchedule,
+    ] {
+        let (mut app, balls) = cradle_stepped(true, stepping);
+        for _ in 0..30 {
+            app.update();
+        }
+        let (p, e) = momentum_and_energy(&app, &balls);
+        let (p0, e0) = (MASS * V0, 0.5 * MASS * V0 * V0);
+        assert!((p / p0 - 1.0).abs() < 1e-5, "{stepping:?}: momentum {p}");
+        assert!((e / e0 - 1.0).abs() < 1e-5, "{stepping:?}: energy {e}");
+        let last = app.world().get::<Velocity>(balls[4]).unwrap().linear.x;
+        assert!(last > 0.9 * V0, "{stepping:?}: last disc {last}");
+        assert!(
+            !app.world().resource::<Seen>().0.is_empty(),
+            "{stepping:?}: no impact message"
+        );
+    }
 }
 
 #[test]
