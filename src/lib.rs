@@ -28,6 +28,8 @@
 #![allow(clippy::duplicate_mod)]
 
 pub mod atomic;
+#[cfg(feature = "bevy")]
+pub mod bevy;
 pub mod coupling;
 pub mod domino;
 pub mod engines;

@@ -28,7 +28,7 @@ mod world;
 pub use backend::math::Real;
 pub use hooks::{ChainedHooks, ToppleHooks};
 pub use pass::{ImpactContact, ImpactEvent};
-pub use scene_build::{build, RowInfo, SceneWorld};
+pub use scene_build::{build, integration_parameters, RowInfo, SceneWorld};
 pub use scene_run::{impact_input_json, run_scene, signed_gap, HitTracker};
 pub use world::{StepParts, ToppleRapier};
 

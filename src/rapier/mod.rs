@@ -154,6 +154,9 @@ pub struct ToppleStats {
     pub rejected_impacts: u64,
     /// Rapier steps split at a predicted impact instant.
     pub split_steps: u64,
+    /// Rapier steps taken (sub-steps and split pieces counted one by one).
+    #[serde(skip)]
+    pub rapier_steps: u64,
     /// Wall time spent in topple's own work, Rapier's step excluded (s).
     /// Not serialized: outputs stay the same bits from run to run.
     #[serde(skip)]

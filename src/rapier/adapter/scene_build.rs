@@ -12,7 +12,7 @@ use super::ToppleRapier;
 use crate::coupling::{ImpactReport, MaterialId};
 use crate::rapier::scene::{
     expand_row, pair_material, topple_settings, BodySpec, Engine, PairLaw, Scene, SceneError,
-    SceneResult, ShapeKind,
+    SceneResult, ShapeKind, SolverSpec,
 };
 
 /// A vector of this build from f64 components.
@@ -131,26 +131,46 @@ fn rapier_world(scene: &Scene, row: Option<&DominoRow>) -> SceneResult<PhysicsWo
     if s.contact_hertz.is_some_and(|f| !(f > 0.0 && f.is_finite())) {
         return Err(SceneError::invalid("contact_hertz must be > 0 and finite"));
     }
-    let mut world = PhysicsWorld {
-        gravity: vector(scene.gravity),
-        integration_parameters: IntegrationParameters {
-            dt: s.dt as Real,
-            length_unit: length_unit as Real,
-            num_solver_iterations: s.iterations.max(1),
-            contact_recycling: s.contact_recycling,
-            ..IntegrationParameters::default()
-        },
-        ..PhysicsWorld::default()
-    };
     let hertz = s
         .contact_hertz
         .or(row.map(|_| crate::rapier::ROW_CONTACT_HERTZ));
-    if let Some(f) = hertz {
-        let p = &mut world.integration_parameters;
+    Ok(PhysicsWorld {
+        gravity: vector(scene.gravity),
+        integration_parameters: integration_parameters(s, length_unit, hertz),
+        ..PhysicsWorld::default()
+    })
+}
+
+/// Rapier's parameters for a scene's solver section: its step `dt` (s), the
+/// length unit (m; Rapier scales its tolerances by it) and, when given, the
+/// natural frequency of soft contacts (Hz; fixed pairs get twice the value,
+/// [`crate::rapier::ROW_CONTACT_HERTZ`] for rows). The one definition used by
+/// the scene worlds and by the Bevy plugin's rows.
+///
+/// ```
+/// use topple::rapier::f64::integration_parameters;
+/// use topple::rapier::scene::SolverSpec;
+/// let p = integration_parameters(&SolverSpec::default(), 0.08, Some(480.0));
+/// assert_eq!(p.length_unit, 0.08);
+/// assert_eq!(p.contact_softness.natural_frequency, 480.0);
+/// ```
+pub fn integration_parameters(
+    s: &SolverSpec,
+    length_unit: f64,
+    contact_hertz: Option<f64>,
+) -> IntegrationParameters {
+    let mut p = IntegrationParameters {
+        dt: s.dt as Real,
+        length_unit: length_unit as Real,
+        num_solver_iterations: s.iterations.max(1),
+        contact_recycling: s.contact_recycling,
+        ..IntegrationParameters::default()
+    };
+    if let Some(f) = contact_hertz {
         p.contact_softness.natural_frequency = f as Real;
         p.static_contact_softness.natural_frequency = (2.0 * f) as Real;
     }
-    Ok(world)
+    p
 }
 
 /// Adds the scene's materials to topple; returns their ids by name.

@@ -88,19 +88,31 @@ impl HitTracker {
     /// Checks the front pair after a step ending at `time` of length `dt` (s).
     pub fn update(&mut self, sw: &SceneWorld, time: f64, dt: f64) {
         let Some(row) = &sw.row else { return };
+        let w = &sw.world;
+        let c = &row.colliders;
+        self.update_with(c.len(), time, dt, |k| {
+            let gap = signed_gap(&w.bodies, &w.colliders, c[k - 1], c[k]);
+            (gap, first_impact(sw, c[k - 1], c[k]))
+        });
+    }
+
+    /// The same for any engine: `probe(k)` gives the signed gap (m) between
+    /// blocks k and k + 1 (1-based; colliders `k − 1` and `k`) at the end of
+    /// the step and, when the engine knows it, the instant (s into the step)
+    /// of an impact between them; `n` is the number of blocks.
+    pub fn update_with(
+        &mut self,
+        n: usize,
+        time: f64,
+        dt: f64,
+        mut probe: impl FnMut(usize) -> (f64, Option<f64>),
+    ) {
         loop {
             let k = self.hit_times.len(); // next pair: blocks k and k + 1 (1-based)
-            if k >= row.colliders.len() {
+            if k >= n {
                 return;
             }
-            let w = &sw.world;
-            let gap = signed_gap(
-                &w.bodies,
-                &w.colliders,
-                row.colliders[k - 1],
-                row.colliders[k],
-            );
-            let struck = first_impact(sw, row.colliders[k - 1], row.colliders[k]);
+            let (gap, struck) = probe(k);
             if gap > HIT_GAP && struck.is_none() {
                 self.prev_gap = Some(gap);
                 return;

@@ -310,6 +310,7 @@ impl ToppleRapier {
                 remaining
             };
             params.dt = h;
+            self.stats.rapier_steps += 1;
             let hooks = ChainedHooks {
                 topple: &self.hooks,
                 user: user_hooks,
