@@ -108,7 +108,23 @@ impl Engine {
     }
 
     fn resolve_impacts_with(&mut self, buf: &mut ImpactBuffers) -> Result<bool, EngineError> {
-        // 1. approaching closed contacts; wake the frozen blocks they strike
+        self.find_approaching(buf)?;
+        if buf.approaching.is_empty() {
+            return Ok(false);
+        }
+        self.mark_group(buf);
+        self.gather_group(buf);
+        if !self.solve_group(buf)? {
+            return Ok(true); // resolved by the plastic fallback
+        }
+        self.apply_outcome(buf);
+        Ok(true)
+    }
+
+    /// Step 1: the closed contacts approaching faster than the impact
+    /// threshold, into `buf.approaching`; the frozen blocks they strike are
+    /// woken (the window grows) until none is left outside it.
+    fn find_approaching(&mut self, buf: &mut ImpactBuffers) -> Result<(), EngineError> {
         let mut woke = true;
         while woke {
             woke = false;
@@ -143,10 +159,13 @@ impl Engine {
                 woke = true;
             }
         }
-        if buf.approaching.is_empty() {
-            return Ok(false);
-        }
-        // 2. the group: runs of moving blocks linked by closed contacts
+        Ok(())
+    }
+
+    /// Step 2: the group, `buf.in_group`: the blocks of the approaching
+    /// contacts and the runs of moving blocks linked to them by closed
+    /// contacts (all closed contacts into `buf.closed`).
+    fn mark_group(&self, buf: &mut ImpactBuffers) {
         let lambda = self.rc.p.lambda_points;
         let nb = self.hi - self.lo;
         let view = self.view();
@@ -185,7 +204,12 @@ impl Engine {
                 buf.in_group[b] = true;
             }
         }
-        // 3. bodies and contacts
+    }
+
+    /// Step 3: the group's bodies (`buf.bodies`, their blocks in
+    /// `buf.members`) and its contacts (`buf.contacts`) for the resolver.
+    fn gather_group(&self, buf: &mut ImpactBuffers) {
+        let nb = self.hi - self.lo;
         let p = self.rc.p;
         buf.index.clear();
         buf.index.resize(nb, usize::MAX);
@@ -208,6 +232,7 @@ impl Engine {
                 buf.members.push(i);
             }
         }
+        let view = self.view();
         let (lo, hi) = (self.lo, self.hi);
         let (in_group, index) = (&buf.in_group, &buf.index);
         let to_body = |j: Option<usize>| -> Option<usize> {
@@ -241,6 +266,12 @@ impl Engine {
                 material: self.material(slot),
             });
         }
+    }
+
+    /// Step 4: the LZB solve with the fallback policy (the e = 0 contacts
+    /// held, then a plastic impact). Returns false when the plastic fallback
+    /// already resolved the group, true when `buf.outcome` is to be applied.
+    fn solve_group(&mut self, buf: &mut ImpactBuffers) -> Result<bool, EngineError> {
         let step_limit = |r: &Result<(), crate::impact::ImpactError>| {
             matches!(r, Err(crate::impact::ImpactError::StepLimit { .. }))
         };
@@ -283,7 +314,7 @@ impl Engine {
         match result {
             Ok(()) if gained(&result, &buf.outcome) => {
                 self.plastic_impact(buf);
-                return Ok(true);
+                return Ok(false);
             }
             Ok(()) => {}
             Err(_) if step_limit(&result) => {
@@ -292,7 +323,7 @@ impl Engine {
                 // leaves no closed contact of the group approaching. Counted
                 // in the report as a fallback.
                 self.plastic_impact(buf);
-                return Ok(true);
+                return Ok(false);
             }
             Err(source) => {
                 return Err(EngineError::Impact {
@@ -301,6 +332,12 @@ impl Engine {
                 })
             }
         }
+        Ok(true)
+    }
+
+    /// Step 5: the resolver's velocities into the state, with the counts and
+    /// the energy bookkeeping.
+    fn apply_outcome(&mut self, buf: &mut ImpactBuffers) {
         let out = &buf.outcome;
         crate::impact::audit::record(&buf.bodies, &buf.contacts, out);
         self.impacts += 1;
@@ -313,6 +350,5 @@ impl Engine {
             self.y[off + 2] = bv.angular_velocity;
         }
         self.sync_out();
-        Ok(true)
     }
 }
