@@ -9,10 +9,11 @@
 //! cargo run --release --features bevy --example cradle -- --screenshot cradle.png --frames 240
 //! ```
 
+mod common;
+
 use std::path::PathBuf;
 
 use bevy::prelude::*;
-use bevy::render::view::screenshot::{save_to_disk, Screenshot, ScreenshotCaptured};
 use bevy::window::WindowResolution;
 use bevy_rapier2d::prelude::*;
 use topple::bevy::{rapier_plugin, ToppleMaterial, TopplePlugin};
@@ -271,16 +272,5 @@ fn finish(mut commands: Commands, run: Res<Run>, mut exit: MessageWriter<AppExit
     let Some((file, frames)) = run.screenshot.clone() else {
         return;
     };
-    if run.frame == frames {
-        commands
-            .spawn(Screenshot::primary_window())
-            .observe(save_to_disk(file))
-            .observe(
-                |_: On<ScreenshotCaptured>, mut exit: MessageWriter<AppExit>| {
-                    exit.write(AppExit::Success);
-                },
-            );
-    } else if run.frame > frames + 120 {
-        exit.write(AppExit::from_code(1));
-    }
+    common::screenshot_then_exit(&mut commands, &mut exit, file, run.frame, frames);
 }

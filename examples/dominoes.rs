@@ -16,10 +16,11 @@
 //! toppled one is orange in the topple row and blue in the native row (the
 //! screenshot check, `.ci/check_screenshot.py`, looks for these colours).
 
+mod common;
+
 use std::path::PathBuf;
 
 use bevy::prelude::*;
-use bevy::render::view::screenshot::{save_to_disk, Screenshot, ScreenshotCaptured};
 use bevy::window::WindowResolution;
 use bevy_rapier2d::plugin::RapierContextInitialization;
 use bevy_rapier2d::prelude::*;
@@ -339,18 +340,8 @@ fn screenshot(
             exit.write(AppExit::from_code(1));
             return;
         }
-        commands
-            .spawn(Screenshot::primary_window())
-            .observe(save_to_disk(file))
-            .observe(
-                |_: On<ScreenshotCaptured>, mut exit: MessageWriter<AppExit>| {
-                    exit.write(AppExit::Success);
-                },
-            );
-    } else if demo.frame > frames + 120 {
-        error!("no screenshot after 120 more frames");
-        exit.write(AppExit::from_code(1));
     }
+    common::screenshot_then_exit(&mut commands, &mut exit, file, demo.frame, frames);
 }
 
 /// The rows as the screenshot shows them: per row the upright and toppled

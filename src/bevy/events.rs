@@ -77,7 +77,6 @@ fn body_entity(bodies: &RigidBodySet, h: RigidBodyHandle) -> Option<Entity> {
 pub(crate) fn collect(
     adapter: &ToppleRapier,
     bodies: &RigidBodySet,
-    _colliders: &ColliderSet,
     context: Entity,
     frame: u64,
     offset: f64,

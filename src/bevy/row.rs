@@ -285,20 +285,17 @@ pub(crate) fn track_rows(
             continue;
         };
         let row = &mut *row;
-        let handles: Vec<_> = row
-            .blocks
-            .iter()
-            .map(|e| colliders.entity2collider().get(e).copied())
-            .collect();
-        if handles.iter().any(Option::is_none) {
-            continue; // Rapier has not created every block yet
-        }
         let start = *row.start.get_or_insert(clock.time - clock.last_frame);
         let blocks = &row.blocks;
         let n = blocks.len();
+        let collider = |e: &Entity| colliders.entity2collider().get(e).copied();
         row.hits
             .update_with(n, clock.time - start, clock.last_frame, |k| {
-                let (a, b) = (handles[k - 1].unwrap(), handles[k].unwrap());
+                // only the front pair is looked at; a block Rapier has not
+                // created yet is not hit
+                let (Some(a), Some(b)) = (collider(&blocks[k - 1]), collider(&blocks[k])) else {
+                    return (f64::INFINITY, None);
+                };
                 let gap = signed_gap(&bodies.bodies, &colliders.colliders, a, b);
                 let struck = impacts
                     .iter()

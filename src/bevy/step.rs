@@ -52,9 +52,11 @@ impl FramePlan {
                 substeps,
             } => {
                 // bevy_rapier's loop: step while the render clock is ahead
+                // (none for a step that is not positive: it would never
+                // catch up)
                 *pending += delta;
                 let mut steps = 0;
-                while *pending > 0.0 {
+                while dt > 0.0 && *pending > 0.0 {
                     steps += 1;
                     *pending -= dt;
                 }
@@ -182,7 +184,6 @@ pub(crate) fn step_contexts(
                 collect(
                     &world.adapter,
                     &bodies.bodies,
-                    &colliders.colliders,
                     entity,
                     clock.frames,
                     offset,
