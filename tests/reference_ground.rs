@@ -98,7 +98,15 @@ fn no_slip_ideal_row_runs_at_the_cooperative_speed() {
         (0.6, 30),
     ] {
         let row = RowSpec::new(p, sh * h, n, 1.0);
-        let r = run(&row, &Settings::default()).unwrap().report;
+        // The model against the theory: the freeze tolerance converged
+        // (10⁻⁴). The default 10⁻² freezes the far end of the slowly
+        // settling leaning train, which pushes the front a little less
+        // (−0.2 % at s/h 0.6; `default_freeze_is_within_half_a_percent`).
+        let converged = Settings {
+            freeze_tolerance: 1e-4,
+            ..Settings::default()
+        };
+        let r = run(&row, &converged).unwrap().report;
         assert_eq!(r.hit_times.len(), n, "s/h {sh}: the wave reaches the end");
         let tail = &r.speeds[n - 12..n - 2];
         let steady = tail.iter().sum::<f64>() / tail.len() as f64;
@@ -113,5 +121,35 @@ fn no_slip_ideal_row_runs_at_the_cooperative_speed() {
             (steady - oracle).abs() < 0.01 * oracle,
             "s/h {sh}: steady {steady} vs cooperative {oracle}"
         );
+    }
+}
+
+/// The defaults (adaptive impulse stepping at 10⁻⁴, freeze tolerance 10⁻²)
+/// against a converged run of the same model (the paper's fixed impulse step
+/// ΔP = 10⁻⁴ P₀, freeze tolerance 10⁻⁴) on ideal Domino T rows, Coulomb and
+/// no-slip ground: v̂_na within 0.5 %.
+#[test]
+fn default_freeze_is_within_half_a_percent() {
+    let converged = Settings {
+        freeze_tolerance: 1e-4,
+        ..Settings::paper_impacts()
+    };
+    for ground in [Ground::Coulomb, Ground::NoSlip] {
+        let mut p = Preset::T.params().ideal();
+        p.ground = ground;
+        for sh in [0.3, 0.6] {
+            let row = RowSpec::new(p, sh * p.block.height, 30, 1.0);
+            let fast = run(&row, &Settings::default()).unwrap().report;
+            let reference = run(&row, &converged).unwrap().report;
+            let (a, b) = (
+                fast.natural_speed.unwrap(),
+                reference.natural_speed.unwrap(),
+            );
+            println!("{ground:?} s/h {sh}: default {a:.5}, converged {b:.5}");
+            assert!(
+                (a - b).abs() < 5e-3 * b,
+                "{ground:?} s/h {sh}: default {a} vs converged {b}"
+            );
+        }
     }
 }

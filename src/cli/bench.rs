@@ -6,10 +6,11 @@
 //!
 //! | run | meaning |
 //! | --- | --- |
-//! | `reference:paper` | reference engine, the paper's improved Euler at 10⁻⁴ s |
+//! | `reference:paper` | reference engine, the paper's improved Euler at 10⁻⁴ s, impacts at the default adaptive impulse stepping (10⁻⁴) |
 //! | `reference:paper:DT` | the same at time step DT (s) |
 //! | `reference:TOL` | reference engine, adaptive Dormand–Prince at tolerance TOL |
-//! | `reference:…:imp:TOL` | either of the above with the resolver's adaptive impulse stepping at TOL (never the default baseline) |
+//! | `reference:…:imp:TOL` | either of the above with adaptive impulse stepping at TOL |
+//! | `reference:…:imp:fixed` | either of the above with the paper's fixed impulse step ΔP = 10⁻⁴ P₀ |
 //! | `rapier:DT` | Rapier with topple at its default settings, time step DT (s) |
 //! | `rapier:DT:STEP` | Rapier with topple, time step DT (s), fixed impulse step ΔP/P₀ = STEP |
 //! | `rapier:DT:tol:TOL` | Rapier with topple, adaptive impulse stepping at TOL |
@@ -19,11 +20,12 @@
 //! the Rapier build; otherwise `--precision` chooses it (default f64).
 //!
 //! Every finished run's report is written to `--out DIR` as JSON; a later call
-//! with the same DIR, row and `--freeze-tolerance` reuses the saved reports instead of
-//! running them again (so a long table can be built in several sittings).
+//! with the same DIR, row and engine settings reuses the saved reports instead
+//! of running them again (so a long table can be built in several sittings).
 //! The error of v̂_na is taken against the `--baseline` run (by default the
 //! reference run with the smallest tolerance, else the reference run with the
-//! smallest time step). Columns besides run time and v̂_na: blocks hit; "out
+//! smallest time step; among those, the tightest impulse stepping).
+//! `--plot FILE` draws the table as a work-precision plot (SVG). Columns besides run time and v̂_na: blocks hit; "out
 //! of order", intervals t_i ≤ 0 (then v̂_na is infinite and shown as none);
 //! "front v̂", the front's distance over time from block 7 to the last block
 //! hit over √(gh), robust to such bunches, with its own error; Rapier's wall
@@ -37,6 +39,7 @@ use anyhow::{bail, Context};
 use super::chain::{row_spec, RowArgs};
 use topple::domino::{ChainReport, RowSpec};
 use topple::engines::{RapierRow, ReferenceRow, RowEngine};
+use topple::impact::StepControl;
 use topple::rapier::scene::{Engine, SolverSpec};
 use topple::rapier::Precision;
 use topple::reference::{Integrator, Settings};
@@ -62,9 +65,9 @@ pub struct Args {
     #[arg(long, default_value_t = topple::coupling::ToppleSettings::DEFAULT_WINDOW)]
     pub window: usize,
     /// Reference runs: freeze blocks behind the wave below this speed
-    /// (fraction of √(gh)) and acceleration (fraction of g); default 10⁻⁴.
-    /// Rows whose blocks keep bouncing behind the wave (Table 1's e1, e2)
-    /// need 10⁻² for a cost linear in the number of blocks.
+    /// (fraction of √(gh)) and acceleration (fraction of g); default 10⁻².
+    /// Below 10⁻², rows whose blocks keep bouncing behind the wave
+    /// (Table 1's e1, e2) cost more than linearly in the number of blocks.
     #[arg(long, allow_hyphen_values = true)]
     pub freeze_tolerance: Option<f64>,
     /// Rapier engines: stop after this much simulated time (s).
@@ -73,15 +76,19 @@ pub struct Args {
     /// Rapier build of the Rapier runs that do not end in `:f32` or `:f64`.
     #[arg(long, value_enum, default_value_t = Precision::F64)]
     pub precision: Precision,
+    /// Also write the work-precision plot (SVG): log₁₀ run time against
+    /// log₁₀ of the v̂_na error of every run but the baseline, one series per
+    /// engine.
+    #[arg(long)]
+    pub plot: Option<PathBuf>,
 }
 
 /// One parsed run.
 #[derive(Clone, Debug, PartialEq)]
 enum RunKind {
-    Reference(Integrator),
-    /// The reference engine with the resolver's adaptive impulse stepping
-    /// at this tolerance (`…:imp:TOL`).
-    ReferenceAdaptiveImpacts(Integrator, f64),
+    /// The reference engine with this smooth integration and impulse
+    /// stepping (`None`: the default, `…:imp:TOL` / `…:imp:fixed`: given).
+    Reference(Integrator, Option<StepControl>),
     Rapier {
         dt: f64,
         impulse_step: Option<f64>,
@@ -117,23 +124,35 @@ fn parse_run(run: &str, default: Precision) -> anyhow::Result<RunKind> {
         parts.pop();
     }
     let precision = named.unwrap_or(default);
-    if let ["reference", head @ .., "imp", tol] = parts.as_slice() {
+    if let ["reference", head @ .., "imp", stepping] = parts.as_slice() {
         if !head.is_empty() {
             let smooth = format!("reference:{}", head.join(":"));
-            let tol = number(tol, "impact tolerance", run)?;
-            if let RunKind::Reference(integrator) = parse_run(&smooth, default)? {
-                return Ok(RunKind::ReferenceAdaptiveImpacts(integrator, tol));
+            let control = if *stepping == "fixed" {
+                StepControl::default()
+            } else {
+                StepControl::Adaptive {
+                    tolerance: number(stepping, "impact tolerance", run)?,
+                }
+            };
+            if let RunKind::Reference(integrator, None) = parse_run(&smooth, default)? {
+                return Ok(RunKind::Reference(integrator, Some(control)));
             }
         }
     }
     Ok(match parts.as_slice() {
-        ["reference", "paper"] => RunKind::Reference(Integrator::Paper { dt: 1e-4 }),
-        ["reference", "paper", dt] => RunKind::Reference(Integrator::Paper {
-            dt: number(dt, "time step", run)?,
-        }),
-        ["reference", tol] => RunKind::Reference(Integrator::Adaptive {
-            tolerance: number(tol, "tolerance", run)?,
-        }),
+        ["reference", "paper"] => RunKind::Reference(Integrator::Paper { dt: 1e-4 }, None),
+        ["reference", "paper", dt] => RunKind::Reference(
+            Integrator::Paper {
+                dt: number(dt, "time step", run)?,
+            },
+            None,
+        ),
+        ["reference", tol] => RunKind::Reference(
+            Integrator::Adaptive {
+                tolerance: number(tol, "tolerance", run)?,
+            },
+            None,
+        ),
         ["rapier", dt, "tol", tol] => RunKind::Rapier {
             dt: number(dt, "time step", run)?,
             impulse_step: None,
@@ -157,7 +176,7 @@ fn parse_run(run: &str, default: Precision) -> anyhow::Result<RunKind> {
             precision,
         },
         _ => bail!(
-            "run {run:?} is not one of reference:paper[:DT], reference:TOL (either may end in :imp:TOL), \
+            "run {run:?} is not one of reference:paper[:DT], reference:TOL (either may end in :imp:TOL or :imp:fixed), \
              rapier:DT, rapier:DT:STEP, rapier:DT:tol:TOL, native:DT (Rapier runs may end in :f32 or :f64)"
         ),
     })
@@ -182,10 +201,29 @@ fn full_name(run: &str, kind: &RunKind) -> String {
 struct Saved {
     run: String,
     row: RowSpec,
-    /// `--freeze-tolerance` of the run (reference runs), if given.
+    /// The whole settings of a reference run (so that a report saved under
+    /// other defaults is not reused).
     #[serde(default)]
-    freeze_tolerance: Option<f64>,
+    settings: Option<Settings>,
     report: ChainReport,
+}
+
+/// The reference engine's settings of a run; `None` for a Rapier run.
+fn reference_settings(kind: &RunKind, args: &Args) -> Option<Settings> {
+    let RunKind::Reference(integrator, control) = *kind else {
+        return None;
+    };
+    let mut settings = Settings {
+        integrator,
+        ..Default::default()
+    };
+    if let Some(control) = control {
+        settings.impact.step_control = control;
+    }
+    if let Some(f) = args.freeze_tolerance {
+        settings.freeze_tolerance = f;
+    }
+    Some(settings)
 }
 
 fn execute(kind: &RunKind, row: &RowSpec, args: &Args) -> anyhow::Result<ChainReport> {
@@ -215,20 +253,9 @@ fn execute_with(
         max_time: args.max_time,
     };
     let engine: Box<dyn RowEngine> = match *kind {
-        RunKind::Reference(integrator) | RunKind::ReferenceAdaptiveImpacts(integrator, _) => {
-            let mut settings = Settings {
-                integrator,
-                ..Default::default()
-            };
-            if let RunKind::ReferenceAdaptiveImpacts(_, tol) = *kind {
-                settings.impact.step_control =
-                    topple::impact::StepControl::Adaptive { tolerance: tol };
-            }
-            if let Some(f) = args.freeze_tolerance {
-                settings.freeze_tolerance = f;
-            }
-            Box::new(ReferenceRow { settings })
-        }
+        RunKind::Reference(..) => Box::new(ReferenceRow {
+            settings: reference_settings(kind, args).expect("a reference run"),
+        }),
         RunKind::Rapier {
             dt,
             impulse_step,
@@ -263,12 +290,23 @@ fn file_name(run: &str) -> String {
 }
 
 /// The default baseline: the reference run with the smallest tolerance, else
-/// the reference run with the smallest time step.
+/// the reference run with the smallest time step; among equals, the one with
+/// the smallest impact tolerance or impulse step (the default counts as
+/// [`Settings::IMPACT_TOLERANCE`]).
 fn default_baseline(kinds: &[(String, RunKind)]) -> Option<usize> {
-    let key = |k: &RunKind| match *k {
-        RunKind::Reference(Integrator::Adaptive { tolerance }) => Some((0, tolerance)),
-        RunKind::Reference(Integrator::Paper { dt }) => Some((1, dt)),
-        _ => None,
+    let key = |k: &RunKind| {
+        let RunKind::Reference(integrator, control) = *k else {
+            return None;
+        };
+        let impacts = match control {
+            Some(StepControl::Adaptive { tolerance }) => tolerance,
+            Some(StepControl::Fixed { impulse_step }) => impulse_step,
+            None => Settings::IMPACT_TOLERANCE,
+        };
+        Some(match integrator {
+            Integrator::Adaptive { tolerance } => (0, tolerance, impacts),
+            Integrator::Paper { dt } => (1, dt, impacts),
+        })
     };
     (0..kinds.len())
         .filter_map(|i| key(&kinds[i].1).map(|k| (k, i)))
@@ -301,11 +339,8 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     for (k, (name, kind)) in kinds.iter().enumerate() {
         let key = full_name(name, kind);
         let path = args.out.as_ref().map(|d| d.join(file_name(&key)));
-        // the freeze tolerance matters to reference runs only
-        let freeze = match kind {
-            RunKind::Reference(_) | RunKind::ReferenceAdaptiveImpacts(..) => args.freeze_tolerance,
-            _ => None,
-        };
+        // the whole settings of a reference run key its saved report
+        let settings = reference_settings(kind, &args);
         let saved = path
             .as_ref()
             .filter(|p| p.exists())
@@ -315,7 +350,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
                 serde_json::from_str(&text).with_context(|| format!("parsing {}", p.display()))
             })
             .transpose()?
-            .filter(|s| s.row == row && s.run == key && s.freeze_tolerance == freeze);
+            .filter(|s| s.row == row && s.run == key && s.settings == settings);
         let report = match saved {
             Some(s) => {
                 eprintln!("[{}/{}] {name}: saved report reused", k + 1, kinds.len());
@@ -338,7 +373,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
                     let saved = Saved {
                         run: key.clone(),
                         row,
-                        freeze_tolerance: freeze,
+                        settings: settings.clone(),
                         report: report.clone(),
                     };
                     std::fs::write(p, serde_json::to_string_pretty(&saved)?)
@@ -350,7 +385,76 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         reports.push(report);
     }
     print_table(&args, &row, &kinds, &reports, baseline);
+    if let Some(path) = &args.plot {
+        plot_work_precision(path, &args, &row, &kinds, &reports, baseline)?;
+        eprintln!("work-precision plot: {}", path.display());
+    }
     Ok(())
+}
+
+/// The engine family of a run: one series of the work-precision plot.
+fn family(kind: &RunKind) -> &'static str {
+    match kind {
+        RunKind::Reference(_, Some(StepControl::Fixed { .. })) => "reference, fixed impulse step",
+        RunKind::Reference(..) => "reference, adaptive impulse step",
+        RunKind::Rapier { .. } => "Rapier + topple",
+        RunKind::Native { .. } => "native Rapier",
+    }
+}
+
+/// The work-precision plot: for every run but the baseline with a finite
+/// v̂_na, (log₁₀ run time (s), log₁₀ |v̂_na error| relative to the baseline),
+/// one series per engine family. An error of exactly 0 is drawn at 10⁻¹⁶.
+fn plot_work_precision(
+    path: &std::path::Path,
+    args: &Args,
+    row: &RowSpec,
+    kinds: &[(String, RunKind)],
+    reports: &[ChainReport],
+    baseline: Option<usize>,
+) -> anyhow::Result<()> {
+    use super::plot::{plot, Curve, Style};
+    let Some(base) = baseline
+        .and_then(|b| reports[b].natural_speed)
+        .filter(|v| v.is_finite())
+    else {
+        bail!("--plot needs a baseline run with a finite v̂_na (see --baseline)");
+    };
+    let mut curves: Vec<Curve> = Vec::new();
+    for (k, ((_, kind), r)) in kinds.iter().zip(reports).enumerate() {
+        let Some(v) = r.natural_speed.filter(|v| v.is_finite()) else {
+            continue;
+        };
+        if Some(k) == baseline || r.run_time <= 0.0 {
+            continue;
+        }
+        let error = ((v - base) / base).abs().max(1e-16);
+        let point = (r.run_time.log10(), error.log10());
+        let name = family(kind);
+        match curves.iter_mut().find(|c| c.name == name) {
+            Some(c) => c.points.push(point),
+            None => curves.push(Curve {
+                name: name.to_string(),
+                points: vec![point],
+                style: Style::Markers,
+                colour: None,
+            }),
+        }
+    }
+    let title = format!(
+        "{:?} row, s/h {}, {} blocks: error against {}",
+        args.row.preset,
+        args.row.spacing_ratio,
+        row.n,
+        baseline.map_or("", |b| kinds[b].0.as_str())
+    );
+    plot(
+        path,
+        &title,
+        "log10 run time (s)",
+        "log10 |v_na error| (relative)",
+        &curves,
+    )
 }
 
 /// The front's mean speed from block 7 to the last block hit, over √(gh):
@@ -370,7 +474,7 @@ fn front_speed(r: &ChainReport, row: &RowSpec) -> Option<f64> {
 fn rapier_dt(kind: &RunKind) -> Option<f64> {
     match *kind {
         RunKind::Rapier { dt, .. } | RunKind::Native { dt, .. } => Some(dt),
-        RunKind::Reference(_) | RunKind::ReferenceAdaptiveImpacts(..) => None,
+        RunKind::Reference(..) => None,
     }
 }
 
@@ -410,7 +514,7 @@ fn print_table(
         });
         let precision = match *kind {
             RunKind::Rapier { precision, .. } | RunKind::Native { precision, .. } => precision,
-            RunKind::Reference(_) | RunKind::ReferenceAdaptiveImpacts(..) => Precision::F64,
+            RunKind::Reference(..) => Precision::F64,
         };
         let native_ms = rapier_dt(kind).and_then(|dt| {
             kinds
@@ -460,19 +564,29 @@ mod tests {
     fn runs_parse_and_bad_ones_are_refused() {
         assert_eq!(
             parse_run("reference:paper", Precision::F64).unwrap(),
-            RunKind::Reference(Integrator::Paper { dt: 1e-4 })
+            RunKind::Reference(Integrator::Paper { dt: 1e-4 }, None)
         );
         assert_eq!(
             parse_run("reference:1e-8", Precision::F64).unwrap(),
-            RunKind::Reference(Integrator::Adaptive { tolerance: 1e-8 })
+            RunKind::Reference(Integrator::Adaptive { tolerance: 1e-8 }, None)
         );
         assert_eq!(
             parse_run("reference:paper:imp:1e-4", Precision::F64).unwrap(),
-            RunKind::ReferenceAdaptiveImpacts(Integrator::Paper { dt: 1e-4 }, 1e-4)
+            RunKind::Reference(
+                Integrator::Paper { dt: 1e-4 },
+                Some(StepControl::Adaptive { tolerance: 1e-4 })
+            )
         );
         assert_eq!(
             parse_run("reference:1e-6:imp:1e-5", Precision::F64).unwrap(),
-            RunKind::ReferenceAdaptiveImpacts(Integrator::Adaptive { tolerance: 1e-6 }, 1e-5)
+            RunKind::Reference(
+                Integrator::Adaptive { tolerance: 1e-6 },
+                Some(StepControl::Adaptive { tolerance: 1e-5 })
+            )
+        );
+        assert_eq!(
+            parse_run("reference:paper:imp:fixed", Precision::F64).unwrap(),
+            RunKind::Reference(Integrator::Paper { dt: 1e-4 }, Some(StepControl::default()))
         );
         assert!(parse_run("reference:imp:1e-4", Precision::F64).is_err());
         assert!(parse_run("reference:paper:imp:-1", Precision::F64).is_err());

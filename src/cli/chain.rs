@@ -7,6 +7,7 @@ use anyhow::Context;
 
 use topple::domino::{Ground, Preset, RowParams, RowSpec};
 use topple::engines::{RapierRow, RowEngine};
+use topple::impact::StepControl;
 use topple::rapier::scene::{Engine, SolverSpec};
 use topple::reference::{snapshot_png, snapshot_svg, Integrator, Settings};
 use topple::validate::{self, EngineKind, InputError, Naming, RunBudget};
@@ -123,10 +124,9 @@ pub struct Args {
     /// Engine.
     #[arg(long, value_enum, default_value = "reference")]
     pub engine: EngineArg,
-    /// Accurate integration at this tolerance (adaptive Dormand–Prince;
-    /// impacts keep the paper's impulse step) instead of the paper's improved
-    /// Euler at --dt. With a Rapier engine: adaptive impulse stepping at this
-    /// tolerance.
+    /// Accurate integration at this tolerance (adaptive Dormand–Prince)
+    /// instead of the paper's improved Euler at --dt. With a Rapier engine:
+    /// adaptive impulse stepping at this tolerance.
     #[arg(long, allow_hyphen_values = true)]
     pub tolerance: Option<f64>,
     /// Fixed time step of the paper's integration (s); with a Rapier engine,
@@ -142,9 +142,18 @@ pub struct Args {
     #[arg(long, allow_hyphen_values = true, default_value_t = 60.0)]
     pub max_time: f64,
     /// Freeze blocks behind the wave below this speed (fraction of √(gh)) and
-    /// acceleration (fraction of g); 0 never freezes.
+    /// acceleration (fraction of g); default 10⁻², 0 never freezes.
     #[arg(long, allow_hyphen_values = true)]
     pub freeze_tolerance: Option<f64>,
+    /// Reference engine: impacts with the paper's fixed impulse step
+    /// ΔP = STEP · P₀ (the paper: 10⁻⁴) instead of adaptive impulse
+    /// stepping.
+    #[arg(long, allow_hyphen_values = true)]
+    pub impact_step: Option<f64>,
+    /// Reference engine: the tolerance of the adaptive impulse stepping
+    /// (default 10⁻⁴).
+    #[arg(long, allow_hyphen_values = true, conflicts_with = "impact_step")]
+    pub impact_tolerance: Option<f64>,
     /// Reference engine: make the heel of every block a contact on the front
     /// face of the block behind (no overlap where blocks slide back; about
     /// twice the run time).
@@ -268,6 +277,19 @@ fn check_args(args: &Args) -> anyhow::Result<RowSpec> {
     if let Some(f) = args.freeze_tolerance {
         validate::check_range("--freeze-tolerance", f, 0.0, 1.0)?;
     }
+    if let Some(step) = args.impact_step {
+        validate::check_range("--impact-step", step, 1e-9, 0.1)?;
+    }
+    if let Some(t) = args.impact_tolerance {
+        validate::check_range("--impact-tolerance", t, 1e-12, 0.1)?;
+    }
+    if rapier && (args.impact_step.is_some() || args.impact_tolerance.is_some()) {
+        Err(InputError::new(
+            "--impact-step/--impact-tolerance",
+            "given with a Rapier engine",
+            "with --engine reference only (Rapier engines: --tolerance)",
+        ))?;
+    }
     let drawing = args.svg.is_some() || args.png.is_some();
     if !args.snapshots.is_empty() && !drawing {
         Err(InputError::new(
@@ -330,6 +352,12 @@ fn reference_settings(args: &Args) -> Settings {
     };
     if let Some(f) = args.freeze_tolerance {
         settings.freeze_tolerance = f;
+    }
+    if let Some(impulse_step) = args.impact_step {
+        settings.impact.step_control = StepControl::Fixed { impulse_step };
+    }
+    if let Some(tolerance) = args.impact_tolerance {
+        settings.impact.step_control = StepControl::Adaptive { tolerance };
     }
     settings.heel_contacts = args.heel_contacts;
     settings.series_blocks = args.series.clone();

@@ -242,6 +242,11 @@ pub struct ImpactSolver {
     rate_change: Vec<f64>,
     /// Normal increments of the step.
     increment: Vec<f64>,
+    /// F_i(E_i) (N) of the energies at the step's start, 0 where unloaded;
+    /// set by the predictor, reused by the error estimate.
+    start_force: Vec<f64>,
+    /// Explicit-Euler increments of the error estimate (adaptive mode).
+    euler_increment: Vec<f64>,
     /// Improved Euler: state saved before the half step, mid-step energies.
     mid_velocity: Vec<[f64; 3]>,
     mid_state: Vec<ContactState>,
@@ -271,6 +276,17 @@ pub struct ImpactSolver {
     step_error: f64,
     /// Adaptive mode is running (the full steps estimate their error).
     adaptive: bool,
+    /// The Gauss nodes warped for an end where E = 0 (see
+    /// [`Self::impact_time`]), for the contacts of `warp.0`'s exponent.
+    warp: (f64, [NodeWarp; 4]),
+}
+
+/// A Gauss node s warped by σ = s^k: (s^k, k s^(k−1)).
+type NodeWarp = (f64, f64);
+
+/// The Gauss nodes warped by σ = s^k (k = α + 1 of the contact law).
+fn warped_nodes(k: f64) -> [NodeWarp; 4] {
+    GAUSS_4.map(|(node, _)| (node.powf(k), k * node.powf(k - 1.0)))
 }
 
 #[inline]
@@ -435,12 +451,20 @@ impl ImpactSolver {
             });
         }
 
+        if let Some(row) = self.rows.first() {
+            let k = 1.0 / (1.0 - row.power);
+            if k != self.warp.0 {
+                self.warp = (k, warped_nodes(k));
+            }
+        }
         let n = self.rows.len();
         let nb = self.velocity.len();
         self.trial.resize(nb, [0.0; 3]);
         self.rate.resize(n, 0.0);
         self.rate_change.resize(n, 0.0);
         self.increment.resize(n, 0.0);
+        self.start_force.resize(n, 0.0);
+        self.euler_increment.resize(n, 0.0);
         self.mid_velocity.resize(nb, [0.0; 3]);
         self.mid_state.resize(n, ContactState::default());
         self.mid_energy.resize(n, 0.0);
@@ -691,13 +715,16 @@ impl ImpactSolver {
         if stage == Stage::Corrector && self.adaptive {
             self.friction_error();
         }
-        // 6. energies with the mid-step rate; 7. impact time and gaps.
+        // 6. energies with the mid-step rate; 7. impact time and gaps (the
+        // predictor keeps only its energies, so it skips them).
         let primary_energy_before = self.state[primary.index].energy;
         let primary_energy_raw = self.update_energies(primary.index, threshold);
-        let (dt, moment) =
-            self.impact_time(primary.index, primary_energy_before, primary_energy_raw);
-        self.elapsed += dt;
-        self.update_gaps(dt, moment, threshold);
+        if stage == Stage::Corrector {
+            let (dt, moment) =
+                self.impact_time(primary.index, primary_energy_before, primary_energy_raw);
+            self.elapsed += dt;
+            self.update_gaps(dt, moment, threshold);
+        }
         Step::Advanced { length: length * h }
     }
 
@@ -794,17 +821,20 @@ impl ImpactSolver {
         let threshold = self.scales.threshold;
         let mut largest = 0.0f64;
         for i in 0..self.rows.len() {
-            let s = &self.state[i];
-            let ratio_energy = if stage == Stage::Corrector && self.mid_energy[i] > 0.0 {
-                self.mid_energy[i]
+            let (row, s) = (&self.rows[i], &self.state[i]);
+            let ratio_force = if stage == Stage::Corrector && self.mid_energy[i] > 0.0 {
+                row.force(self.mid_energy[i])
             } else {
-                s.energy
+                row.force(s.energy)
             };
+            if stage == Stage::Predictor {
+                self.start_force[i] = ratio_force;
+            }
             let inc = Self::increment_of(
-                &self.rows[i],
+                row,
                 s,
                 self.rate[i],
-                ratio_energy,
+                ratio_force,
                 h,
                 primary.force,
                 (threshold, self.adaptive),
@@ -1156,11 +1186,16 @@ impl ImpactSolver {
         let (a, b) = (-inc * r0 / eta, -inc * 0.5 * (r1 - r0) / eta);
         let energy = |sigma: f64| (e0 + sigma * (a + sigma * b)).max(0.0);
         let k = 1.0 / (1.0 - row.power);
+        let warp = if k == self.warp.0 {
+            self.warp.1
+        } else {
+            warped_nodes(k)
+        };
         let (mut t0, mut t1) = (0.0, 0.0);
-        for (node, weight) in GAUSS_4 {
+        for ((node, weight), (node_k, slope_k)) in GAUSS_4.into_iter().zip(warp) {
             // first half, σ = ½ s^k if E vanishes at 0, else σ = ½ s
             let (sigma, jac) = if e0 <= 0.0 {
-                (0.5 * node.powf(k), 0.5 * k * node.powf(k - 1.0))
+                (0.5 * node_k, 0.5 * slope_k)
             } else {
                 (0.5 * node, 0.5)
             };
@@ -1171,7 +1206,7 @@ impl ImpactSolver {
             }
             // second half, from the end
             let (sigma, jac) = if e1 <= 0.0 {
-                (1.0 - 0.5 * node.powf(k), 0.5 * k * node.powf(k - 1.0))
+                (1.0 - 0.5 * node_k, 0.5 * slope_k)
             } else {
                 (1.0 - 0.5 * node, 0.5)
             };
@@ -1221,7 +1256,7 @@ impl ImpactSolver {
 
     /// Normal increment of one contact for a step of primary impulse `h`
     /// (N·s) whose primary pushes with `primary_force` (N): loaded contacts
-    /// in the ratio F_i(E_i)/F_p (docs/model.md §1, E_i = `ratio_energy`);
+    /// in the ratio F_i(E_i)/F_p (docs/model.md §1, F_i = `ratio_force`);
     /// approaching closed contacts without energy start as in the contact
     /// law, E_i ≈ |δ̇_i| dP_i. The fixed step uses docs/model.md §3,
     /// dP_i = (h c_i / F_p)^(α+1) |δ̇_i|^α, which takes the force at the
@@ -1234,15 +1269,15 @@ impl ImpactSolver {
         row: &Row,
         s: &ContactState,
         rate: f64,
-        ratio_energy: f64,
+        ratio_force: f64,
         h: f64,
         primary_force: f64,
         (threshold, time_exact): (f64, bool),
     ) -> f64 {
         if !row.movable {
             0.0
-        } else if ratio_energy > 0.0 {
-            h * row.force(ratio_energy) / primary_force
+        } else if ratio_force > 0.0 {
+            h * ratio_force / primary_force
         } else if s.gap == 0.0 && !s.held && rate < -threshold {
             let a1 = row.exponent + 1.0;
             let start = if time_exact { 1.0 / a1 } else { 1.0 };
@@ -1257,7 +1292,7 @@ impl ImpactSolver {
     /// which the improved-Euler increments `increment` (times `scale`) differ
     /// from the explicit-Euler ones, distributed with the start energies
     /// (primary force `start_force`). Second order in h.
-    fn ratio_error(&self, h: f64, scale: f64, start_force: f64, threshold: f64) -> f64 {
+    fn ratio_error(&mut self, h: f64, scale: f64, start_force: f64, threshold: f64) -> f64 {
         if start_force <= 0.0 {
             return 0.0;
         }
@@ -1265,32 +1300,30 @@ impl ImpactSolver {
         let mut largest = 0.0f64;
         for i in 0..n {
             let (row, s) = (&self.rows[i], &self.state[i]);
+            // a contact still loaded here holds its start energy (landings
+            // only release), whose force the predictor kept
+            let ratio_force = if s.energy > 0.0 {
+                self.start_force[i]
+            } else {
+                0.0
+            };
             let inc = Self::increment_of(
                 row,
                 s,
                 self.rate[i],
-                s.energy,
+                ratio_force,
                 h,
                 start_force,
                 (threshold, true),
             );
+            self.euler_increment[i] = inc;
             largest = largest.max(inc);
         }
         let start_scale = if largest > h { h / largest } else { 1.0 };
         let mut worst = 0.0f64;
         for i in 0..n {
-            let (row, s) = (&self.rows[i], &self.state[i]);
-            let euler = start_scale
-                * Self::increment_of(
-                    row,
-                    s,
-                    self.rate[i],
-                    s.energy,
-                    h,
-                    start_force,
-                    (threshold, true),
-                );
-            let diff = (self.increment[i] * scale - euler).abs() * row.w_nn;
+            let euler = start_scale * self.euler_increment[i];
+            let diff = (self.increment[i] * scale - euler).abs() * self.rows[i].w_nn;
             worst = worst.max(diff);
         }
         worst / self.scales.velocity

@@ -37,13 +37,20 @@ impl Default for Integrator {
 /// let s = Settings::accurate(1e-8);
 /// assert_eq!(s.integrator, Integrator::Adaptive { tolerance: 1e-8 });
 /// assert_eq!(Settings::default().integrator, Integrator::Paper { dt: 1e-4 });
+/// // impacts: adaptive impulse stepping; the paper's fixed step on request
+/// let paper = Settings::paper_impacts();
+/// assert_eq!(paper.impact.step_control, topple::impact::StepControl::Fixed { impulse_step: 1e-4 });
 /// ```
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Settings {
     /// Time integration of the smooth phase.
     pub integrator: Integrator,
-    /// Impulse stepping of the impacts (default: the paper's ΔP = 10⁻⁴ P₀,
-    /// at most 2·10⁵ steps). An impact that needs more is solved again with
+    /// Impulse stepping of the impacts (default: adaptive at
+    /// [`Settings::IMPACT_TOLERANCE`], at most 2·10⁵ steps; the paper's fixed
+    /// ΔP = 10⁻⁴ P₀ with [`Settings::paper_impacts`]). On Domino X, Table 1,
+    /// s/h 0.52, 1,000 blocks the two give v̂_na 1.5310 and 1.5321, and
+    /// adaptive 10⁻⁵ 1.5316 (docs/reference-performance.md), at a quarter of
+    /// the run time. An impact that needs more is solved again with
     /// its e = 0 contacts held closed (counted in
     /// [`crate::domino::ChainReport::held_impacts`]); if that fails too it is
     /// resolved as plastic ([`crate::domino::ChainReport::impact_fallbacks`]).
@@ -58,9 +65,14 @@ pub struct Settings {
     /// A closed contact approaching faster than this fraction of √(gh) starts
     /// an impact (default 10⁻⁶, round-off level).
     pub approach_tolerance: f64,
-    /// A block behind the wave is frozen when its speeds are below this
-    /// fraction of √(gh) and its accelerations below this fraction of g
-    /// (default 10⁻⁴).
+    /// A block at the back of the moving window is frozen (taken out of the
+    /// integration, its kinetic energy booked as `frozen`) when its speeds
+    /// are below this fraction of √(gh) and its accelerations below this
+    /// fraction of g (default [`Settings::FREEZE_TOLERANCE`] = 10⁻²). Rows whose
+    /// blocks keep bouncing behind the wave (Table 1's e1, e2) never get below
+    /// 10⁻³ and the window then grows with the row: Domino X, s/h 0.52,
+    /// 100 blocks, took 90 s at 10⁻³ and 5.4 s at 10⁻², v̂_na within 0.2 %
+    /// over 10⁻⁴ … 3·10⁻² (docs/reference-performance.md).
     pub freeze_tolerance: f64,
     /// Events are located to this time (s) (default 10⁻¹⁰).
     pub event_time_tolerance: f64,
@@ -104,12 +116,12 @@ impl Default for Settings {
             integrator: Integrator::default(),
             impact: ImpactSettings {
                 max_steps: 200_000,
-                ..ImpactSettings::default()
+                ..ImpactSettings::adaptive(Self::IMPACT_TOLERANCE)
             },
             gap_tolerance: 1e-6,
             velocity_tolerance: 1e-3,
             approach_tolerance: 1e-6,
-            freeze_tolerance: 1e-4,
+            freeze_tolerance: Self::FREEZE_TOLERANCE,
             event_time_tolerance: 1e-10,
             heel_contacts: false,
             held_retry_after: 20_000,
@@ -124,10 +136,22 @@ impl Default for Settings {
 }
 
 impl Settings {
+    /// The default tolerance of the adaptive impulse stepping (relative to
+    /// the approach speed, see [`crate::impact::StepControl::Adaptive`]).
+    pub const IMPACT_TOLERANCE: f64 = 1e-4;
+    /// The default freeze tolerance (see [`Settings::freeze_tolerance`]).
+    pub const FREEZE_TOLERANCE: f64 = 1e-2;
+
+    /// The defaults with the paper's fixed impulse step ΔP = 10⁻⁴ P₀
+    /// (Sec. 3.1) in the impacts.
+    pub fn paper_impacts() -> Self {
+        let mut s = Self::default();
+        s.impact.step_control = crate::impact::StepControl::default();
+        s
+    }
+
     /// The accurate integration: adaptive Dormand–Prince at `tolerance` for
-    /// the smooth phase; impacts keep the paper's fixed impulse step (the
-    /// resolver's adaptive mode is not used here yet: with it some impacts of a
-    /// long leaning group exceeded the step limit).
+    /// the smooth phase; impacts as in the defaults.
     pub fn accurate(tolerance: f64) -> Self {
         Settings {
             integrator: Integrator::Adaptive { tolerance },
