@@ -862,14 +862,19 @@ impl ImpactSolver {
         let n = self.rows.len();
         let threshold = self.scales.threshold;
         let mut sweeping = false;
+        // Only held, stuck and no-slip contacts read the trial velocities;
+        // without them one sweep settles every impulse.
+        let mut coupled = false;
         for i in 0..n {
             self.tangent_step[i] = 0.0;
             self.held_step[i] = 0.0;
             let row = &self.rows[i];
             let s = &self.state[i];
-            self.stuck_at_start[i] = Self::tangent_rate(row, &self.velocity).abs() <= threshold;
-            sweeping |=
-                row.movable && (s.held || (self.increment[i] > 0.0 && Self::has_friction(row)));
+            let stuck = Self::tangent_rate(row, &self.velocity).abs() <= threshold;
+            self.stuck_at_start[i] = stuck;
+            let rubbing = self.increment[i] > 0.0 && Self::has_friction(row);
+            sweeping |= row.movable && (s.held || rubbing);
+            coupled |= row.movable && (s.held || (rubbing && (stuck || row.no_slip())));
         }
         if !sweeping {
             return;
@@ -928,7 +933,7 @@ impl ImpactSolver {
                 );
                 largest_change = largest_change.max(moved);
             }
-            if largest_change <= settled {
+            if largest_change <= settled || !coupled {
                 break;
             }
         }

@@ -66,8 +66,33 @@ pub(crate) struct Kin {
 
 #[inline]
 fn rot(phi: f64, p: [f64; 2]) -> [f64; 2] {
-    let (s, c) = phi.sin_cos();
+    let (s, c) = turn(phi);
     [c * p[0] - s * p[1], s * p[0] + c * p[1]]
+}
+
+/// (sin φ, cos φ), remembered for the last few angles of this thread: the
+/// candidates of one block ask for the same angle several times per
+/// evaluation (one to three corners per slot, λ + 3 slots). Exact: a hit
+/// returns what `sin_cos` gave for the same bits.
+#[inline]
+fn turn(phi: f64) -> (f64, f64) {
+    use std::cell::Cell;
+    const SLOTS: usize = 16;
+    const EMPTY: Cell<(u64, f64, f64)> = Cell::new((u64::MAX, 0.0, 0.0));
+    thread_local! {
+        static SEEN: [Cell<(u64, f64, f64)>; SLOTS] = const { [EMPTY; SLOTS] };
+    }
+    let bits = phi.to_bits();
+    let slot = ((bits ^ (bits >> 29) ^ (bits >> 47)) as usize) % SLOTS;
+    SEEN.with(|seen| {
+        let (key, s, c) = seen[slot].get();
+        if key == bits {
+            return (s, c);
+        }
+        let (s, c) = phi.sin_cos();
+        seen[slot].set((bits, s, c));
+        (s, c)
+    })
 }
 
 #[inline]
