@@ -140,6 +140,14 @@ fn row_parameters_out_of_range_are_refused() {
         (&["--window", "0"], "--window"),
         (&["--wall-limit", "0"], "--wall-limit"),
         (&["--series", "9"], "--series"),
+        (&["--impact-step", "0"], "--impact-step"),
+        (&["--impact-step", "1"], "--impact-step"),
+        (&["--impact-tolerance", "NaN"], "--impact-tolerance"),
+        (&["--impact-tolerance", "0.5"], "--impact-tolerance"),
+        (
+            &["--engine", "rapier", "--impact-step", "1e-4"],
+            "--impact-step/--impact-tolerance",
+        ),
     ];
     for (extra, field) in cases {
         refused_chain(extra, field, "allowed");

@@ -115,3 +115,40 @@ fn bad_runs_and_baselines_are_refused_with_one_line() {
     }
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+#[test]
+fn the_plot_has_a_series_per_engine_and_changed_settings_rerun() {
+    let dir = std::env::temp_dir().join(format!("topple-cli-bench-plot-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    let svg = dir.join("work-precision.svg");
+    let runs = "reference:paper:imp:fixed,reference:paper,native:1e-3";
+    let extra = [
+        "--baseline",
+        "reference:paper:imp:fixed",
+        "--plot",
+        svg.to_str().unwrap(),
+    ];
+    let first = bench(&dir, runs, &extra);
+    assert!(
+        first.status.success(),
+        "{}",
+        String::from_utf8_lossy(&first.stderr)
+    );
+    let plot = std::fs::read_to_string(&svg).unwrap();
+    assert!(plot.starts_with("<svg"), "{}", &plot[..80.min(plot.len())]);
+    // the baseline is the only fixed-step run, so that series is empty
+    assert!(plot.contains("reference, adaptive impulse step"));
+    assert!(plot.contains("native Rapier"));
+    assert!(!plot.contains("reference, fixed impulse step"));
+
+    // another freeze tolerance: the reference runs' saved reports do not
+    // match their settings and run again; the Rapier run is reused
+    let mut changed = extra.to_vec();
+    changed.extend(["--freeze-tolerance", "1e-3"]);
+    let second = bench(&dir, runs, &changed);
+    assert!(second.status.success());
+    let stderr = String::from_utf8_lossy(&second.stderr);
+    assert_eq!(stderr.matches(": running").count(), 2, "{stderr}");
+    assert_eq!(stderr.matches("saved report reused").count(), 1, "{stderr}");
+    let _ = std::fs::remove_dir_all(&dir);
+}

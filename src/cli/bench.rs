@@ -442,7 +442,8 @@ fn plot_work_precision(
         }
     }
     let title = format!(
-        "{:?} row, s/h {}, {} blocks: error against {}",
+        "{}{:?} row, s/h {}, {} blocks: error against {}",
+        if args.row.ideal { "ideal " } else { "" },
         args.row.preset,
         args.row.spacing_ratio,
         row.n,

@@ -277,12 +277,7 @@ fn check_args(args: &Args) -> anyhow::Result<RowSpec> {
     if let Some(f) = args.freeze_tolerance {
         validate::check_range("--freeze-tolerance", f, 0.0, 1.0)?;
     }
-    if let Some(step) = args.impact_step {
-        validate::check_range("--impact-step", step, 1e-9, 0.1)?;
-    }
-    if let Some(t) = args.impact_tolerance {
-        validate::check_range("--impact-tolerance", t, 1e-12, 0.1)?;
-    }
+    validate::impact_stepping(args.impact_step, args.impact_tolerance)?;
     if rapier && (args.impact_step.is_some() || args.impact_tolerance.is_some()) {
         Err(InputError::new(
             "--impact-step/--impact-tolerance",

@@ -119,3 +119,33 @@ pub fn impact(bodies: &[Body], contacts: &[Contact]) -> Result<(), InputError> {
     }
     Ok(())
 }
+
+/// Smallest and largest fixed impulse step ΔP/P₀ of the reference engine's
+/// impacts (`--impact-step`): below, an impact takes more steps than its
+/// limit; above, one step is a tenth of the impact.
+pub const IMPACT_STEP_RANGE: (f64, f64) = (1e-9, 0.1);
+/// Smallest and largest adaptive impulse tolerance (`--impact-tolerance`):
+/// below, round-off; above, no accuracy left.
+pub const IMPACT_TOLERANCE_RANGE: (f64, f64) = (1e-12, 0.1);
+
+/// Checks the impulse stepping asked of the reference engine's impacts: a
+/// fixed step ΔP/P₀ (`--impact-step`) or an adaptive tolerance
+/// (`--impact-tolerance`), each optional.
+///
+/// ```
+/// use topple::validate::impact_stepping;
+/// assert!(impact_stepping(Some(1e-4), None).is_ok());
+/// let e = impact_stepping(None, Some(0.5)).unwrap_err();
+/// assert_eq!(e.to_string(), "--impact-tolerance = 0.5: allowed 1e-12 ≤ --impact-tolerance ≤ 0.1");
+/// ```
+pub fn impact_stepping(step: Option<f64>, tolerance: Option<f64>) -> Result<(), InputError> {
+    if let Some(step) = step {
+        let (lo, hi) = IMPACT_STEP_RANGE;
+        check_range("--impact-step", step, lo, hi)?;
+    }
+    if let Some(tolerance) = tolerance {
+        let (lo, hi) = IMPACT_TOLERANCE_RANGE;
+        check_range("--impact-tolerance", tolerance, lo, hi)?;
+    }
+    Ok(())
+}

@@ -9,7 +9,7 @@
 //! | [`row()`], [`RunBudget`], [`Naming`] | `row.rs` | a domino row, the engine's time step, tolerance and budget |
 //! | [`memory_estimate`], [`check_memory`] | `memory.rs` | what a row of n blocks needs against what the machine has |
 //! | [`scene()`], [`parse_toml`], [`SyntaxError`] | `scene.rs` | a TOML scene: ranges, degenerate shapes, overlapping bodies; one-line parse errors |
-//! | [`impact()`] | `impact.rs` | the magnitudes of an impact given as JSON |
+//! | [`impact()`], [`impact_stepping`] | `impact.rs` | the magnitudes of an impact given as JSON; the reference engine's impulse stepping flags |
 //!
 //! ```
 //! use topple::validate::check_range;
@@ -23,7 +23,7 @@ mod memory;
 pub mod row;
 mod scene;
 
-pub use impact::impact;
+pub use impact::{impact, impact_stepping};
 pub use memory::{available_memory, check_memory, memory_estimate, EngineKind};
 pub use row::{row, Naming, RunBudget};
 pub(crate) use scene::box_overlap;

@@ -81,12 +81,7 @@ fn check_args(args: &Args) -> Result<(), InputError> {
         validate::check_open_low("--spacings", sh, 0.0, 0.999)?;
     }
     validate::check_open_low("--run-limit", args.run_limit, 0.0, 1e7)?;
-    if let Some(t) = args.impact_tolerance {
-        validate::check_open_low("--impact-tolerance", t, 0.0, 0.999)?;
-    }
-    if let Some(step) = args.impact_step {
-        validate::check_range("--impact-step", step, 1e-9, 0.1)?;
-    }
+    validate::impact_stepping(args.impact_step, args.impact_tolerance)?;
     Ok(())
 }
 
