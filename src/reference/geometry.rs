@@ -78,9 +78,9 @@ fn rot(phi: f64, p: [f64; 2]) -> [f64; 2] {
 fn turn(phi: f64) -> (f64, f64) {
     use std::cell::Cell;
     const SLOTS: usize = 16;
-    const EMPTY: Cell<(u64, f64, f64)> = Cell::new((u64::MAX, 0.0, 0.0));
     thread_local! {
-        static SEEN: [Cell<(u64, f64, f64)>; SLOTS] = const { [EMPTY; SLOTS] };
+        static SEEN: [Cell<(u64, f64, f64)>; SLOTS] =
+            const { [const { Cell::new((u64::MAX, 0.0, 0.0)) }; SLOTS] };
     }
     let bits = phi.to_bits();
     let slot = ((bits ^ (bits >> 29) ^ (bits >> 47)) as usize) % SLOTS;
