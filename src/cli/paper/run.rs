@@ -48,11 +48,21 @@ pub fn run_jobs(jobs: &[Job], store: &RunStore, resume: bool) -> Results {
     results
 }
 
+/// How a job's figure is named in messages: `fig 5`, or `fig5_ground` for
+/// the ground-law figure (job id [`super::jobs::GROUND_FIG`]).
+fn figure_label(fig: u32) -> String {
+    if fig == super::jobs::GROUND_FIG {
+        "fig5_ground".to_string()
+    } else {
+        format!("fig {fig}")
+    }
+}
+
 /// One run; a finished one (not cut by its wall-clock limit) is saved.
 fn run_and_save(j: &Job, store: &RunStore) -> Result<ChainReport, String> {
     let report = run(&j.row, &j.settings)
         .map(|o| o.report)
-        .map_err(|e| format!("fig {} {} x={}: {e}", j.fig, j.key, j.x))?;
+        .map_err(|e| format!("{} {} x={}: {e}", figure_label(j.fig), j.key, j.x))?;
     if !report.stopped_early {
         if let Err(e) = store.save(&j.row, &j.settings, &report) {
             eprintln!("warning: could not save a finished run: {e:#}");
@@ -68,8 +78,8 @@ pub fn warn_incomplete(jobs: &[Job], results: &Results) {
         match r {
             Err(e) => eprintln!("warning: {e}"),
             Ok(r) if r.stopped_early || r.impact_fallbacks > 0 || r.held_impacts > 0 => eprintln!(
-                "warning: fig {} {} x={}: {}{} plastic fallbacks, {} held impacts, {} of {} blocks reached",
-                j.fig,
+                "warning: {} {} x={}: {}{} plastic fallbacks, {} held impacts, {} of {} blocks reached",
+                figure_label(j.fig),
                 j.key,
                 j.x,
                 if r.stopped_early { "run limit hit, " } else { "" },
