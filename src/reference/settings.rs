@@ -49,8 +49,9 @@ pub struct Settings {
     /// [`Settings::IMPACT_TOLERANCE`], at most 2·10⁵ steps; the paper's fixed
     /// ΔP = 10⁻⁴ P₀ with [`Settings::paper_impacts`]). On Domino X, Table 1,
     /// s/h 0.52, 1,000 blocks the two give v̂_na 1.5310 and 1.5321, and
-    /// adaptive 10⁻⁵ 1.5316 (docs/reference-performance.md), at a quarter of
-    /// the run time. An impact that needs more is solved again with
+    /// adaptive 10⁻⁵ 1.5316 (docs/reference-performance.md); the default
+    /// took a fifth of the fixed step's run time there. An impact that needs
+    /// more than its step limit is solved again with
     /// its e = 0 contacts held closed (counted in
     /// [`crate::domino::ChainReport::held_impacts`]); if that fails too it is
     /// resolved as plastic ([`crate::domino::ChainReport::impact_fallbacks`]).
