@@ -45,14 +45,13 @@ mod band;
 mod dynamics;
 mod engine;
 mod geometry;
-mod impacts;
 mod modes;
 mod settings;
 mod snapshot;
 mod stepper;
 
-pub use engine::{run, run_with_progress, EngineError, RunResult, Snapshot};
+pub use engine::{run, run_with_progress, EngineError, RunResult};
 pub use settings::{Integrator, Settings};
 #[cfg(feature = "plots")]
 pub use snapshot::snapshot_png;
-pub use snapshot::{snapshot_svg, PNG_BLOCK};
+pub use snapshot::{snapshot_svg, Snapshot, PNG_BLOCK};

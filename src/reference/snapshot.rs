@@ -2,8 +2,16 @@
 
 use std::fmt::Write;
 
-use super::engine::Snapshot;
 use crate::domino::Block;
+
+/// The whole row at one time.
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+pub struct Snapshot {
+    /// Time (s).
+    pub time: f64,
+    /// (x, y, φ) of every block: centre (m) and counter-clockwise angle (rad).
+    pub blocks: Vec<[f64; 3]>,
+}
 
 /// An SVG drawing of the row at the given snapshots, one above the other,
 /// blocks from `first` to `last` (0-based, inclusive). Coordinates in mm.

@@ -7,72 +7,14 @@
 //! tail at rest behind the wave would take a vanishing share of the impulse; if
 //! the impact drives a block into it, that is a new impact which wakes it).
 
-use super::dynamics::{Active, Mode};
-use super::engine::{Engine, EngineError};
-use super::geometry::{surface, Surface};
+use super::super::geometry::{surface, Surface};
+use super::{Engine, EngineError, ImpactBuffers};
+use crate::coupling::Resolution;
 use crate::domino::Ground;
-use crate::impact::{Body, Contact, ContactMaterial, ImpactOutcome};
-
-/// Buffers of [`Engine::resolve_impacts`], kept between impacts so that a
-/// long row allocates nothing per impact once they have grown.
-#[derive(Debug, Default)]
-pub(crate) struct ImpactBuffers {
-    /// Closed contacts approaching faster than the approach tolerance.
-    approaching: Vec<(usize, usize)>,
-    /// Every closed contact (block, slot) of the window.
-    closed: Vec<(usize, usize)>,
-    /// Window block b linked to b + 1 by a closed contact.
-    linked: Vec<bool>,
-    /// Window block b takes part in the impact.
-    in_group: Vec<bool>,
-    /// Window block b → its index among `bodies`.
-    index: Vec<usize>,
-    bodies: Vec<Body>,
-    /// Row index of each of `bodies`.
-    members: Vec<usize>,
-    contacts: Vec<Contact>,
-    outcome: ImpactOutcome,
-    plastic: Vec<Active>,
-}
+use crate::impact::{Body, Contact, ContactMaterial};
 
 impl Engine {
-    fn plastic_impact(&mut self, buf: &mut ImpactBuffers) {
-        let lambda = self.rc.p.lambda_points;
-        let (lo, hi) = (self.lo, self.hi);
-        let in_group = &buf.in_group;
-        let member = |j: usize| j >= lo && j < hi && in_group[j - lo];
-        let act = &mut buf.plastic;
-        act.clear();
-        for &(i, slot) in &buf.closed {
-            let inside = if slot <= lambda {
-                member(i)
-            } else {
-                member(i) && member(i + 1)
-            };
-            if inside {
-                let (_, mus) = self.rc.mu(slot);
-                act.push(Active {
-                    block: i,
-                    slot,
-                    mode: if mus > 0.0 {
-                        Mode::Stick
-                    } else {
-                        Mode::Frictionless
-                    },
-                });
-            }
-        }
-        let before = self.window_energy();
-        self.dynamics
-            .project(&self.rc, lo, hi, &mut self.y, &self.pos, act, self.v_tol);
-        let after = self.window_energy();
-        self.energy.impacts += before - after;
-        self.impacts += 1;
-        self.impact_fallbacks += 1;
-        self.sync_out();
-    }
-
-    fn material(&self, slot: usize) -> ContactMaterial {
+    pub(super) fn material(&self, slot: usize) -> ContactMaterial {
         let p = &self.rc.p;
         let f = p.impact_friction_factor;
         let (k, e, mu, mus) = match surface(slot, p.lambda_points) {
@@ -100,23 +42,24 @@ impl Engine {
     }
 
     /// Resolves the impacts present now, if any. Returns whether there was one.
-    pub(crate) fn resolve_impacts(&mut self) -> Result<bool, EngineError> {
+    pub(super) fn resolve_impacts(&mut self) -> Result<bool, EngineError> {
         let mut buf = std::mem::take(&mut self.impact_buffers);
         let result = self.resolve_impacts_with(&mut buf);
         self.impact_buffers = buf;
         result
     }
 
-    fn resolve_impacts_with(&mut self, buf: &mut ImpactBuffers) -> Result<bool, EngineError> {
+    pub(super) fn resolve_impacts_with(
+        &mut self,
+        buf: &mut ImpactBuffers,
+    ) -> Result<bool, EngineError> {
         self.find_approaching(buf)?;
         if buf.approaching.is_empty() {
             return Ok(false);
         }
         self.mark_group(buf);
         self.gather_group(buf);
-        if !self.solve_group(buf)? {
-            return Ok(true); // resolved by the plastic fallback
-        }
+        self.solve_group(buf)?;
         self.apply_outcome(buf);
         Ok(true)
     }
@@ -124,7 +67,7 @@ impl Engine {
     /// Step 1: the closed contacts approaching faster than the impact
     /// threshold, into `buf.approaching`; the frozen blocks they strike are
     /// woken (the window grows) until none is left outside it.
-    fn find_approaching(&mut self, buf: &mut ImpactBuffers) -> Result<(), EngineError> {
+    pub(super) fn find_approaching(&mut self, buf: &mut ImpactBuffers) -> Result<(), EngineError> {
         let mut woke = true;
         while woke {
             woke = false;
@@ -165,7 +108,7 @@ impl Engine {
     /// Step 2: the group, `buf.in_group`: the blocks of the approaching
     /// contacts and the runs of moving blocks linked to them by closed
     /// contacts (all closed contacts into `buf.closed`).
-    fn mark_group(&self, buf: &mut ImpactBuffers) {
+    pub(super) fn mark_group(&self, buf: &mut ImpactBuffers) {
         let lambda = self.rc.p.lambda_points;
         let nb = self.hi - self.lo;
         let view = self.view();
@@ -208,16 +151,16 @@ impl Engine {
 
     /// Step 3: the group's bodies (`buf.bodies`, their blocks in
     /// `buf.members`) and its contacts (`buf.contacts`) for the resolver.
-    fn gather_group(&self, buf: &mut ImpactBuffers) {
+    pub(super) fn gather_group(&self, buf: &mut ImpactBuffers) {
         let nb = self.hi - self.lo;
         let p = self.rc.p;
         buf.index.clear();
-        buf.index.resize(nb, usize::MAX);
+        buf.index.resize(nb, None);
         buf.bodies.clear();
         buf.members.clear();
         for b in 0..nb {
             if buf.in_group[b] {
-                buf.index[b] = buf.bodies.len();
+                buf.index[b] = Some(buf.bodies.len());
                 let i = self.lo + b;
                 let (q, v) = self.state(i);
                 buf.bodies.push(Body {
@@ -238,7 +181,7 @@ impl Engine {
         let to_body = |j: Option<usize>| -> Option<usize> {
             let j = j?;
             if j >= lo && j < hi && in_group[j - lo] {
-                Some(index[j - lo])
+                index[j - lo]
             } else {
                 None
             }
@@ -268,78 +211,42 @@ impl Engine {
         }
     }
 
-    /// Step 4: the LZB solve with the fallback policy (the e = 0 contacts
-    /// held, then a plastic impact). Returns false when the plastic fallback
-    /// already resolved the group, true when `buf.outcome` is to be applied.
-    fn solve_group(&mut self, buf: &mut ImpactBuffers) -> Result<bool, EngineError> {
-        let step_limit = |r: &Result<(), crate::impact::ImpactError>| {
-            matches!(r, Err(crate::impact::ImpactError::StepLimit { .. }))
-        };
-        // Only e = 0 contacts can be held; with none, a retry would repeat
-        // the same computation.
-        let can_hold =
-            !self.s.impact.e0_hold && buf.contacts.iter().any(|c| c.material.restitution == 0.0);
-        let first = if can_hold {
-            crate::impact::ImpactSettings {
-                max_steps: self.s.held_retry_after.min(self.s.impact.max_steps),
-                ..self.s.impact
-            }
-        } else {
-            self.s.impact
-        };
-        let mut result =
-            self.solver
-                .solve_into(&buf.bodies, &buf.contacts, &first, &mut buf.outcome);
-        // an outcome that created energy is not accepted (the same rule as
-        // the Rapier adapter's fallback policy, `coupling::fallback`)
-        let gained = |r: &Result<(), _>, out: &crate::impact::ImpactOutcome| {
-            r.is_ok() && crate::coupling::gains_energy(out)
-        };
-        if (step_limit(&result) || gained(&result, &buf.outcome)) && can_hold {
-            // The paper's e = 0 law did not finish: a wedged group whose e = 0
-            // contacts release and reload in ever smaller cycles. Their limit
-            // is a contact held closed, which `e0_hold` solves directly (the
-            // e > 0 contacts keep the LZB law). Counted as a held impact.
-            let held = crate::impact::ImpactSettings {
-                e0_hold: true,
-                ..self.s.impact
-            };
-            result = self
-                .solver
-                .solve_into(&buf.bodies, &buf.contacts, &held, &mut buf.outcome);
-            if result.is_ok() && !gained(&result, &buf.outcome) {
-                self.held_impacts += 1;
-            }
+    /// Step 4: the solve, by the coupling layer's policy
+    /// ([`crate::coupling::GroupSolver`], the same code as the Rapier
+    /// adapter's): the paper's LZB law; for a group with e = 0 contacts
+    /// that has not finished after `held_retry_after` impulse steps (a
+    /// wedged group whose e = 0 contacts release and reload in ever smaller
+    /// cycles), again with those contacts held closed, their limit (counted
+    /// as a held impact); if that fails too, or an outcome would create
+    /// kinetic energy, a plastic impact with Coulomb friction (counted as a
+    /// fallback). Only input the resolver refuses (a non-finite state)
+    /// fails the run.
+    pub(super) fn solve_group(&mut self, buf: &mut ImpactBuffers) -> Result<(), EngineError> {
+        let how = self
+            .solver
+            .solve_into(
+                &buf.bodies,
+                &buf.contacts,
+                &self.s.impact,
+                &self.policy,
+                &mut buf.outcome,
+            )
+            .map_err(|source| EngineError::Impact {
+                time: self.t,
+                source,
+            })?;
+        match how {
+            Resolution::Lzb | Resolution::Rejected => {}
+            Resolution::Held => self.held_impacts += 1,
+            Resolution::Plastic => self.impact_fallbacks += 1,
         }
-        match result {
-            Ok(()) if gained(&result, &buf.outcome) => {
-                self.plastic_impact(buf);
-                return Ok(false);
-            }
-            Ok(()) => {}
-            Err(_) if step_limit(&result) => {
-                // Still unfinished: resolve this one as a plastic impact, the
-                // smallest velocity change (in kinetic-energy norm) that
-                // leaves no closed contact of the group approaching. Counted
-                // in the report as a fallback.
-                self.plastic_impact(buf);
-                return Ok(false);
-            }
-            Err(source) => {
-                return Err(EngineError::Impact {
-                    time: self.t,
-                    source,
-                })
-            }
-        }
-        Ok(true)
+        Ok(())
     }
 
     /// Step 5: the resolver's velocities into the state, with the counts and
     /// the energy bookkeeping.
-    fn apply_outcome(&mut self, buf: &mut ImpactBuffers) {
+    pub(super) fn apply_outcome(&mut self, buf: &mut ImpactBuffers) {
         let out = &buf.outcome;
-        crate::impact::audit::record(&buf.bodies, &buf.contacts, out);
         self.impacts += 1;
         self.energy.impacts += out.kinetic_energy_before - out.kinetic_energy_after;
         for (k, &i) in buf.members.iter().enumerate() {

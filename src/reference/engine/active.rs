@@ -1,0 +1,174 @@
+//! The active set: the mode search among the closed contacts (paper
+//! Eqs. 18–20, `modes.rs`) and the projection that keeps the pressing
+//! contacts exactly closed, with its energy change booked.
+
+use super::super::dynamics::{Active, RowConst, View};
+use super::super::geometry::{Geom, Kin};
+use super::super::modes::{initial_mode, select, Candidate};
+use super::Engine;
+
+/// Slot `slot` of block `i` if it is a closed contact (gap ≤ `eps`, m)
+/// between moving blocks, with its kinematics. Contacts with a frozen block
+/// never press: a moving block that approaches a frozen one starts an
+/// impact, which wakes it.
+fn closed_between_moving(
+    rc: &RowConst,
+    view: &View,
+    i: usize,
+    slot: usize,
+    eps: f64,
+) -> Option<(Geom, Kin)> {
+    let g = rc.geom(view, i, slot)?;
+    if !g.valid || g.gap > eps {
+        return None;
+    }
+    if view.local(Some(g.corner)).is_none() || (g.face.is_some() && view.local(g.face).is_none()) {
+        return None;
+    }
+    let k = rc.kin(view, &g);
+    Some((g, k))
+}
+
+impl Engine {
+    pub(super) fn set_active(&mut self) {
+        for a in &self.active {
+            self.is_active[a.block * self.k_slots + a.slot] = false;
+        }
+        std::mem::swap(&mut self.active, &mut self.new_active);
+        for a in &self.active {
+            self.is_active[a.block * self.k_slots + a.slot] = true;
+        }
+    }
+
+    /// [`Engine::project`], then the closed contacts left out of the active
+    /// set that the projection drives into approach join it and the
+    /// projection is repeated from the same state: the velocities end on
+    /// {active: δ̇ = 0, other closed contacts: δ̇ ≥ 0}.
+    ///
+    /// Used once impacts repeat at one instant (`handle_events`): a
+    /// face-to-face pair (B_i and the heel contact closed together) can
+    /// cycle there. The impact leaves the heel separating at 10⁻⁷ m/s, the
+    /// mode search (acceleration level) does not need it, the projection of
+    /// B_i turns the pair so that the heel approaches at 4·10⁻⁵ m/s, and the
+    /// impact that follows at the same instant starts the cycle again (ideal
+    /// Domino T rows with `heel_contacts`). Not used otherwise: where blocks
+    /// chatter at the back of a Table 1 row, contacts joined this way are
+    /// dropped by the next mode search and joined again thousands of times.
+    pub(super) fn project_unilateral(&mut self) {
+        let start = self.y.clone();
+        let booked = self.energy.projection;
+        for _ in 0..4 {
+            self.project();
+            let mut joined = std::mem::take(&mut self.new_active);
+            joined.clear();
+            {
+                let view = self.view();
+                let (rc, tol, eps, vapp) = (&self.rc, &self.tol, self.eps_gap, self.v_app);
+                let k = self.k_slots;
+                let is_active = &self.is_active;
+                self.for_each_slot(|i, slot| {
+                    if is_active[i * k + slot] {
+                        return;
+                    }
+                    let Some((_, kk)) = closed_between_moving(rc, &view, i, slot, eps) else {
+                        return;
+                    };
+                    if kk.gdot < -vapp {
+                        joined.push(Active {
+                            block: i,
+                            slot,
+                            mode: initial_mode(rc, slot, kk.vt, tol),
+                        });
+                    }
+                });
+            }
+            if joined.is_empty() {
+                self.new_active = joined;
+                break;
+            }
+            joined.extend_from_slice(&self.active);
+            // the band solve wants the contacts sorted by block
+            joined.sort_by_key(|a| (a.block, a.slot));
+            self.new_active = joined;
+            self.set_active();
+            self.y.copy_from_slice(&start);
+            self.energy.projection = booked;
+        }
+    }
+
+    /// Projection onto the active constraints, with its energy change booked.
+    pub(super) fn project(&mut self) {
+        let before = self.window_energy();
+        let (lo, hi) = (self.lo, self.hi);
+        let mut act = std::mem::take(&mut self.new_active);
+        act.clear();
+        act.extend_from_slice(&self.active);
+        let n_before = act.len();
+        self.dynamics.project(
+            &self.rc,
+            lo,
+            hi,
+            &mut self.y,
+            &self.pos,
+            &mut act,
+            self.v_tol,
+        );
+        self.new_active = act;
+        if self.new_active.len() != n_before {
+            self.set_active();
+        }
+        let after = self.window_energy();
+        self.energy.projection += before - after;
+    }
+
+    /// The contact mode at the present state (paper Eqs. 18–20): the closed
+    /// contacts between moving blocks that neither approach nor separate are
+    /// the candidates, the active-set search picks which press and how they
+    /// rub, and they become the active set.
+    pub(super) fn choose_mode(&mut self) {
+        // candidates: closed, valid, neither approaching nor separating
+        let mut cands = std::mem::take(&mut self.candidates);
+        cands.clear();
+        {
+            let view = self.view();
+            let rc = &self.rc;
+            let eps = self.eps_gap;
+            let vt = self.v_tol;
+            let vapp = self.v_app;
+            self.for_each_slot(|i, slot| {
+                let Some((_, k)) = closed_between_moving(rc, &view, i, slot, eps) else {
+                    return;
+                };
+                if k.gdot >= -vapp && k.gdot <= vt {
+                    cands.push(Candidate {
+                        block: i,
+                        slot,
+                        vt: k.vt,
+                    });
+                }
+            });
+        }
+        {
+            let view = View {
+                lo: self.lo,
+                hi: self.hi,
+                y: &self.y,
+                pos: &self.pos,
+            };
+            // a search that does not converge keeps its last mode minus any
+            // pulling contact (see `select`); the events of the next step
+            // correct it
+            let _ = select(
+                &mut self.dynamics,
+                &self.rc,
+                &view,
+                &cands,
+                &mut self.mode_state,
+                &mut self.new_active,
+                &self.tol,
+            );
+        }
+        self.candidates = cands;
+        self.set_active();
+    }
+}

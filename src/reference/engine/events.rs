@@ -1,0 +1,109 @@
+//! What happened inside a step (a closed contact approaching, lift-off,
+//! stick → slip, slip reversal, a contact leaving its face) and the answer
+//! at the located instant: impacts until none is left, hits, the contact
+//! mode, the projection, the derivative for the next step.
+
+use super::super::dynamics::{Mode, View};
+use super::{Engine, EngineError};
+
+impl Engine {
+    /// True if any event happened in state `y1` (the dynamics must hold the
+    /// forces at `y1`). Also tracks the deepest penetration.
+    pub(super) fn events_at(&mut self, y1: &[f64]) -> bool {
+        let mut event = false;
+        for (c, a) in self.active.iter().enumerate() {
+            let d = &self.dynamics;
+            let fnn = d.fn_[c];
+            if !d.valid[c] || fnn < self.ref_fn[c] - self.tol.force {
+                event = true;
+            }
+            match a.mode {
+                Mode::Stick => {
+                    if self.rc.stick_excess(a.slot, d.ft[c], fnn)
+                        > self.ref_stick[c] + self.tol.force
+                    {
+                        event = true;
+                    }
+                }
+                Mode::Slide(dir) => {
+                    if dir * d.vt[c] < self.ref_slide[c] - 0.5 * self.v_tol {
+                        event = true;
+                    }
+                }
+                Mode::Frictionless => {}
+            }
+        }
+        let view = View {
+            lo: self.lo,
+            hi: self.hi,
+            y: y1,
+            pos: &self.pos,
+        };
+        let mut deepest = self.dynamics.gap.iter().cloned().fold(0.0f64, f64::min);
+        let k = self.k_slots;
+        let rc = &self.rc;
+        let is_active = &self.is_active;
+        let eps = self.eps_gap;
+        let vapp = self.v_app;
+        self.for_each_slot(|i, slot| {
+            if is_active[i * k + slot] || event {
+                return;
+            }
+            let Some(g) = rc.geom(&view, i, slot) else {
+                return;
+            };
+            if !g.valid {
+                return;
+            }
+            deepest = deepest.min(g.gap);
+            if g.gap >= -eps {
+                return;
+            }
+            let kk = rc.kin(&view, &g);
+            if kk.gdot < -vapp {
+                event = true;
+            }
+        });
+        // The heel-on-front-face pairs inside the row are not contacts (see
+        // for_each_slot) but their overlap is measured, so that the reported
+        // penetration covers every corner the row can drive into a neighbour.
+        let lambda = self.rc.p.lambda_points;
+        for i in self.lo.saturating_sub(1)..self.hi.min(self.row.n.saturating_sub(2)) {
+            if let Some(g) = rc.geom(&view, i, lambda + 2) {
+                if g.valid {
+                    deepest = deepest.min(g.gap);
+                }
+            }
+        }
+        self.max_penetration = self.max_penetration.max(-deepest);
+        event
+    }
+
+    /// Impacts, contact mode, projection; then the derivative for the next step.
+    pub(super) fn handle_events(&mut self) -> Result<(), EngineError> {
+        self.sync_out();
+        let mut impacted = false;
+        for _ in 0..20 {
+            if !self.resolve_impacts()? {
+                break;
+            }
+            impacted = true;
+        }
+        if impacted {
+            if self.t - self.last_impact_time <= self.s.event_time_tolerance {
+                self.impacts_at_this_instant += 1;
+            } else {
+                self.impacts_at_this_instant = 0;
+            }
+            self.last_impact_time = self.t;
+        }
+        self.record_hits();
+        self.choose_mode();
+        if self.impacts_at_this_instant >= 2 {
+            self.project_unilateral();
+        } else {
+            self.project();
+        }
+        self.eval_k0()
+    }
+}

@@ -1,0 +1,212 @@
+//! One step of the smooth phase (paper Eqs. 17–20 with the contact mode held
+//! fixed): the derivative, the paper's improved Euler or Dormand–Prince with
+//! error control, and the step shortened by bisection to the first event.
+
+use super::super::dynamics::Active;
+use super::super::dynamics::{Dynamics, Mode, RowConst, View};
+use super::super::settings::Integrator;
+use super::super::stepper::{DOPRI5, HEUN};
+use super::{Engine, EngineError};
+
+fn rhs(
+    dynamics: &mut Dynamics,
+    rc: &RowConst,
+    lo: usize,
+    hi: usize,
+    pos: &[[f64; 3]],
+    active: &[Active],
+    y: &[f64],
+    dy: &mut [f64],
+) -> bool {
+    let view = View { lo, hi, y, pos };
+    if !dynamics.forces(rc, &view, active) {
+        return false;
+    }
+    for b in 0..hi - lo {
+        for x in 0..3 {
+            dy[6 * b + x] = y[6 * b + 3 + x];
+            dy[6 * b + 3 + x] = dynamics.acc[b][x];
+        }
+    }
+    let last = dy.len() - 1;
+    dy[last] = -dynamics.power;
+    dy.iter().all(|v| v.is_finite())
+}
+
+impl Engine {
+    pub(super) fn eval_k0(&mut self) -> Result<(), EngineError> {
+        self.k0.resize(self.y.len(), 0.0);
+        self.evaluations += 1;
+        if !rhs(
+            &mut self.dynamics,
+            &self.rc,
+            self.lo,
+            self.hi,
+            &self.pos,
+            &self.active,
+            &self.y,
+            &mut self.k0,
+        ) {
+            return Err(EngineError::Singular(self.t));
+        }
+        // event references at the start of the step
+        self.ref_fn.clear();
+        self.ref_stick.clear();
+        self.ref_slide.clear();
+        for (c, a) in self.active.iter().enumerate() {
+            let fnn = self.dynamics.fn_[c];
+            self.ref_fn.push(fnn.min(0.0));
+            self.ref_stick.push(
+                self.rc
+                    .stick_excess(a.slot, self.dynamics.ft[c], fnn)
+                    .max(0.0),
+            );
+            let dir = match a.mode {
+                Mode::Slide(d) => d,
+                _ => 0.0,
+            };
+            self.ref_slide.push((dir * self.dynamics.vt[c]).min(0.0));
+        }
+        Ok(())
+    }
+
+    /// The step's error estimate against the tolerance (Dormand–Prince;
+    /// 0 for the paper's fixed step): above 1 the step is rejected.
+    pub(super) fn error_norm(&self) -> f64 {
+        let Integrator::Adaptive { tolerance } = self.s.integrator else {
+            return 0.0;
+        };
+        let p = &self.rc.p;
+        let scales = [
+            p.block.height,
+            p.block.height,
+            1.0,
+            p.speed_scale(),
+            p.speed_scale(),
+            p.speed_scale() / p.block.height,
+        ];
+        let mut worst = 0.0f64;
+        let n = self.y.len() - 1;
+        for x in 0..n {
+            let e = self.stages.err[x].abs() / (tolerance * scales[x % 6]);
+            worst = worst.max(e);
+        }
+        let ework = p.block.mass * p.gravity * p.block.height;
+        worst.max(self.stages.err[n].abs() / (tolerance * ework))
+    }
+
+    /// One trial step of size h from `y` into `y1`; false if singular.
+    pub(super) fn trial(&mut self, h: f64) -> bool {
+        let tab = match self.s.integrator {
+            Integrator::Paper { .. } => &HEUN,
+            Integrator::Adaptive { .. } => &DOPRI5,
+        };
+        let dynamics = &mut self.dynamics;
+        let rc = &self.rc;
+        let (lo, hi) = (self.lo, self.hi);
+        let pos = &self.pos;
+        let active = &self.active;
+        let mut evals = 0;
+        let ok = self
+            .stages
+            .step(tab, h, &self.y, &self.k0, &mut self.y1, |y, dy| {
+                evals += 1;
+                rhs(dynamics, rc, lo, hi, pos, active, y, dy)
+            });
+        self.evaluations += evals;
+        ok
+    }
+
+    /// Forces at y1 into the dynamics (for the event test).
+    pub(super) fn forces_at_y1(&mut self) -> bool {
+        let view = View {
+            lo: self.lo,
+            hi: self.hi,
+            y: &self.y1,
+            pos: &self.pos,
+        };
+        self.evaluations += 1;
+        self.dynamics.forces(&self.rc, &view, &self.active)
+    }
+
+    /// Advances by one accepted step (possibly shortened to an event).
+    pub(super) fn advance(&mut self, t_end: f64) -> Result<(), EngineError> {
+        let mut h = match self.s.integrator {
+            Integrator::Paper { dt } => dt,
+            Integrator::Adaptive { .. } => self.h_adapt,
+        };
+        h = h.min(t_end - self.t).max(1e-14);
+        // error control
+        let mut tries = 0;
+        let mut h_next = h;
+        loop {
+            tries += 1;
+            if tries > 60 {
+                return Err(EngineError::Singular(self.t));
+            }
+            if !self.trial(h) {
+                h *= 0.5;
+                continue;
+            }
+            let err = self.error_norm();
+            if err > 1.0 {
+                h *= (0.9 * err.powf(-0.2)).clamp(0.1, 0.5);
+                continue;
+            }
+            if let Integrator::Adaptive { .. } = self.s.integrator {
+                let grow = if err > 0.0 {
+                    (0.9 * err.powf(-0.2)).clamp(0.2, 5.0)
+                } else {
+                    5.0
+                };
+                h_next = (h * grow).min(0.002 * self.rc.p.time_scale());
+            }
+            break;
+        }
+        // events
+        let mut event = false;
+        if !self.forces_at_y1() {
+            return Err(EngineError::Singular(self.t));
+        }
+        let y1 = std::mem::take(&mut self.y1);
+        let ev = self.events_at(&y1);
+        self.y1 = y1;
+        if ev {
+            event = true;
+            let (mut a, mut b) = (0.0, h);
+            self.ybest.clone_from(&self.y1);
+            while b - a > self.s.event_time_tolerance {
+                let mid = 0.5 * (a + b);
+                let ok = self.trial(mid) && self.forces_at_y1();
+                let y1 = std::mem::take(&mut self.y1);
+                let ev = !ok || self.events_at(&y1);
+                self.y1 = y1;
+                if ev {
+                    b = mid;
+                    self.ybest.clone_from(&self.y1);
+                } else {
+                    a = mid;
+                }
+            }
+            h = b;
+            std::mem::swap(&mut self.y1, &mut self.ybest);
+            h_next = h_next.max(1e-3 * self.rc.p.time_scale().min(h_next));
+        }
+        std::mem::swap(&mut self.y, &mut self.y1);
+        self.t += h;
+        self.steps += 1;
+        let last = self.y.len() - 1;
+        self.energy.friction += self.y[last];
+        self.y[last] = 0.0;
+        self.h_adapt = h_next;
+        if event {
+            self.handle_events()?;
+        } else {
+            self.project();
+            self.eval_k0()?;
+        }
+        self.freeze()?;
+        self.record();
+        Ok(())
+    }
+}

@@ -1,0 +1,307 @@
+//! The reference engine's driver, in named stages: the smooth phase
+//! integrated with the contact mode held fixed, events located inside steps
+//! (contact closing, lift-off, stick ↔ slip, slip reversal), impacts resolved
+//! through the coupling layer's LZB → held → plastic policy, and the
+//! time-varying set of moving blocks (the paper's κ, Sec. 2.1): blocks ahead
+//! of the wave stand frozen until struck, blocks at rest behind it are frozen
+//! until touched.
+//!
+//! [`Engine`]'s state is private to this folder; each file extends its impl
+//! with one stage, in the order a step runs them:
+//!
+//! | file | stage |
+//! | --- | --- |
+//! | `integrate.rs` | one step of the smooth phase (Heun or Dormand–Prince), shortened to the first event by bisection |
+//! | `events.rs` | what happened in a step (contacts closing, lift-off, stick ↔ slip, slip reversal) and the response: impacts, then the contact mode |
+//! | `impacts.rs` | one impact: the approaching contacts, the group they start, the LZB solve through [`crate::coupling::GroupSolver`] |
+//! | `active.rs` | the active set: the mode search among closed contacts and the projection onto the active constraints |
+//! | `window.rs` | the moving blocks lo..hi: their state vector, the candidate slots, waking and freezing |
+//! | `record.rs` | hits, rebounds, series, snapshots and the final report |
+//!
+//! The stage files import from this file and the leaf modules of
+//! `reference` (geometry, dynamics, modes, stepper), never from each other.
+
+use std::time::Instant;
+
+use super::dynamics::{Active, Dynamics, Mode, RowConst};
+use super::geometry::slots_per_block;
+use super::modes::{Candidate, ModeTol};
+use super::settings::Settings;
+use super::snapshot::Snapshot;
+use super::stepper::Stages;
+use crate::coupling::{FallbackPolicy, GroupSolver};
+use crate::domino::{BlockSeries, ChainReport, EnergyReport, RowSpec};
+use crate::impact::{Body, Contact, ImpactOutcome};
+
+mod active;
+mod events;
+mod impacts;
+mod integrate;
+mod record;
+mod window;
+
+/// Why a run failed.
+#[derive(Debug, thiserror::Error)]
+pub enum EngineError {
+    /// The row is not usable.
+    #[error("invalid row: {0}")]
+    InvalidRow(String),
+    /// The impact resolver refused an impact's input (a non-finite state).
+    #[error("impact at t = {time} s: {source}")]
+    Impact {
+        /// Time (s).
+        time: f64,
+        /// The resolver's error.
+        source: crate::impact::ImpactError,
+    },
+    /// The contact equations became singular or the state non-finite.
+    #[error("the smooth phase failed at t = {0} s (singular contact system)")]
+    Singular(f64),
+}
+
+/// The result of a run.
+#[derive(Clone, Debug)]
+pub struct RunResult {
+    /// The engine-independent report (hit times, speeds, energy, …).
+    pub report: ChainReport,
+    /// The snapshots asked for.
+    pub snapshots: Vec<Snapshot>,
+    /// Accepted time steps.
+    pub steps: usize,
+    /// Right-hand-side evaluations (contact-force solves).
+    pub evaluations: usize,
+}
+
+/// Scratch of the impact stage (`impacts.rs`), kept between impacts so that
+/// a long row allocates nothing per impact once it has grown.
+#[derive(Debug, Default)]
+struct ImpactBuffers {
+    /// Closed contacts approaching faster than the approach tolerance.
+    approaching: Vec<(usize, usize)>,
+    /// Every closed contact (block, slot) of the window.
+    closed: Vec<(usize, usize)>,
+    /// Window block b linked to b + 1 by a closed contact.
+    linked: Vec<bool>,
+    /// Window block b takes part in the impact.
+    in_group: Vec<bool>,
+    /// Window block b → its index among `bodies`.
+    index: Vec<Option<usize>>,
+    bodies: Vec<Body>,
+    /// Row index of each of `bodies`.
+    members: Vec<usize>,
+    contacts: Vec<Contact>,
+    outcome: ImpactOutcome,
+}
+
+/// The state of a running simulation. Private to the stage files of this
+/// folder; the rest of the crate runs it through [`run`].
+struct Engine {
+    rc: RowConst,
+    row: RowSpec,
+    s: Settings,
+    /// Candidate slots per block ([`slots_per_block`]).
+    k_slots: usize,
+    // --- window (`window.rs`)
+    /// Configuration and velocity of every block (window blocks: see `y`).
+    pos: Vec<[f64; 3]>,
+    vel: Vec<[f64; 3]>,
+    /// Moving blocks lo..hi.
+    lo: usize,
+    hi: usize,
+    /// Window state (6 per block) + the contact work accumulator.
+    y: Vec<f64>,
+    // --- integration (`integrate.rs`)
+    /// Time (s).
+    t: f64,
+    k0: Vec<f64>,
+    y1: Vec<f64>,
+    ybest: Vec<f64>,
+    stages: Stages,
+    h_adapt: f64,
+    steps: usize,
+    evaluations: usize,
+    // --- active set (`active.rs`)
+    dynamics: Dynamics,
+    active: Vec<Active>,
+    is_active: Vec<bool>,
+    candidates: Vec<Candidate>,
+    mode_state: Vec<Option<Mode>>,
+    new_active: Vec<Active>,
+    // --- events (`events.rs`): references per active contact at the step start
+    ref_fn: Vec<f64>,
+    ref_stick: Vec<f64>,
+    ref_slide: Vec<f64>,
+    /// Time (s) of the last impact, and how many `handle_events` calls in a
+    /// row have found an impact at that same instant.
+    last_impact_time: f64,
+    impacts_at_this_instant: usize,
+    // --- impacts (`impacts.rs`)
+    solver: GroupSolver,
+    policy: FallbackPolicy,
+    impact_buffers: ImpactBuffers,
+    // --- tolerances in SI
+    eps_gap: f64,
+    v_tol: f64,
+    v_app: f64,
+    tol: ModeTol,
+    // --- records (`record.rs`)
+    hit: Vec<Option<f64>>,
+    energy: EnergyReport,
+    max_penetration: f64,
+    impacts: usize,
+    impact_fallbacks: usize,
+    held_impacts: usize,
+    reversed: Vec<bool>,
+    series: Vec<BlockSeries>,
+    next_sample: f64,
+    snapshots: Vec<Snapshot>,
+    next_snapshot: usize,
+}
+
+impl Engine {
+    fn new(row: &RowSpec, settings: &Settings) -> Result<Engine, EngineError> {
+        row.validate().map_err(EngineError::InvalidRow)?;
+        let p = row.params;
+        let n = row.n;
+        let rc = RowConst::new(p, n);
+        let k_slots = slots_per_block(p.lambda_points);
+        let mut pos = Vec::with_capacity(n);
+        for i in 0..n {
+            let c = row.centre(i);
+            pos.push([c[0], c[1], 0.0]);
+        }
+        let mut vel = vec![[0.0; 3]; n];
+        let (v0, w0) = row.initial_velocity();
+        vel[0] = [v0[0], v0[1], w0];
+        let vbar = p.speed_scale();
+        let m = p.block.mass;
+        let mut e = Engine {
+            rc,
+            row: *row,
+            s: settings.clone(),
+            k_slots,
+            pos,
+            vel,
+            lo: 0,
+            hi: 1,
+            y: Vec::new(),
+            k0: Vec::new(),
+            y1: Vec::new(),
+            ybest: Vec::new(),
+            t: 0.0,
+            active: Vec::new(),
+            is_active: vec![false; n * k_slots],
+            dynamics: Dynamics::default(),
+            stages: Stages::default(),
+            solver: GroupSolver::default(),
+            // the reference's own budgets: the held retry after
+            // `held_retry_after` impulse steps, every attempt within the
+            // resolver's step limit
+            policy: FallbackPolicy {
+                held_retry_after: settings.held_retry_after,
+                max_steps: settings.impact.max_steps,
+            },
+            impact_buffers: ImpactBuffers::default(),
+            hit: vec![None; n],
+            energy: EnergyReport::default(),
+            max_penetration: 0.0,
+            impacts: 0,
+            impact_fallbacks: 0,
+            held_impacts: 0,
+            reversed: vec![false; n],
+            last_impact_time: f64::NEG_INFINITY,
+            impacts_at_this_instant: 0,
+            steps: 0,
+            evaluations: 0,
+            ref_fn: Vec::new(),
+            ref_stick: Vec::new(),
+            ref_slide: Vec::new(),
+            candidates: Vec::new(),
+            mode_state: Vec::new(),
+            new_active: Vec::new(),
+            eps_gap: settings.gap_tolerance * p.block.height,
+            v_tol: settings.velocity_tolerance * vbar,
+            v_app: settings.approach_tolerance * vbar,
+            tol: ModeTol {
+                force: 1e-9 * m * p.gravity,
+                accel: 1e-9 * p.gravity,
+                velocity: settings.velocity_tolerance * vbar,
+            },
+            series: settings
+                .series_blocks
+                .iter()
+                .map(|&b| BlockSeries {
+                    block: b,
+                    ..Default::default()
+                })
+                .collect(),
+            next_sample: 0.0,
+            snapshots: Vec::new(),
+            next_snapshot: 0,
+            h_adapt: 1e-4,
+        };
+        e.hit[0] = Some(0.0);
+        e.sync_in();
+        e.energy.initial = e.total_energy();
+        Ok(e)
+    }
+}
+
+/// Runs the reference engine on a row.
+///
+/// ```no_run
+/// use topple::domino::{Preset, RowSpec};
+/// use topple::reference::{run, Settings};
+/// let p = Preset::T.params().ideal();
+/// let row = RowSpec::new(p, 0.35 * p.block.height, 30, 1.0);
+/// let out = run(&row, &Settings::default()).unwrap();
+/// println!("v_na = {:?}", out.report.natural_speed);
+/// ```
+pub fn run(row: &RowSpec, settings: &Settings) -> Result<RunResult, EngineError> {
+    run_with_progress(row, settings, |_| {})
+}
+
+/// [`run`], calling `progress` with the number of blocks hit so far each time
+/// the wave reaches another block (for a progress bar on long rows).
+///
+/// ```
+/// use topple::domino::{Preset, RowSpec};
+/// use topple::reference::{run_with_progress, Settings};
+/// let p = Preset::T.params().ideal();
+/// let row = RowSpec::new(p, 0.5 * p.block.height, 4, 1.0);
+/// let mut seen = Vec::new();
+/// let out = run_with_progress(&row, &Settings::default(), |hit| seen.push(hit)).unwrap();
+/// assert_eq!(seen, (1..=out.report.hit_times.len()).collect::<Vec<_>>());
+/// ```
+pub fn run_with_progress(
+    row: &RowSpec,
+    settings: &Settings,
+    mut progress: impl FnMut(usize),
+) -> Result<RunResult, EngineError> {
+    let start = Instant::now();
+    let mut e = Engine::new(row, settings)?;
+    let t_max = settings
+        .t_max
+        .unwrap_or(40.0 * row.params.time_scale() * (row.n as f64 + 5.0));
+    e.handle_events()?;
+    e.record();
+    let mut stopped_early = false;
+    let mut hits_seen = 0;
+    while e.lo < e.hi && e.t < t_max {
+        if settings.stop_at_last_hit && e.hit[row.n - 1].is_some() {
+            break;
+        }
+        if let Some(limit) = settings.wall_time_limit {
+            if start.elapsed().as_secs_f64() > limit {
+                stopped_early = true;
+                break;
+            }
+        }
+        e.advance(t_max)?;
+        while hits_seen < row.n && e.hit[hits_seen].is_some() {
+            hits_seen += 1;
+            progress(hits_seen);
+        }
+    }
+    Ok(e.finish(start, stopped_early))
+}

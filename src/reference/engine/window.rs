@@ -1,0 +1,155 @@
+//! The window of moving blocks lo..hi (the paper's κ, Sec. 2.1): its
+//! state vector, the energies it holds, the candidate slots that involve a
+//! moving block, and freezing the blocks at rest at its back.
+
+use super::super::dynamics::View;
+use super::{Engine, EngineError};
+
+impl Engine {
+    /// Kinetic and potential energy of the whole row (J).
+    pub(super) fn total_energy(&self) -> f64 {
+        let (k, u) = self.energies();
+        k + u
+    }
+
+    pub(super) fn energies(&self) -> (f64, f64) {
+        self.energies_of(0, self.row.n)
+    }
+
+    /// Kinetic + potential energy of the moving blocks only (J): what a
+    /// projection or impact can change, in O(window).
+    pub(super) fn window_energy(&self) -> f64 {
+        let (k, u) = self.energies_of(self.lo, self.hi);
+        k + u
+    }
+
+    pub(super) fn energies_of(&self, from: usize, to: usize) -> (f64, f64) {
+        let b = &self.rc.p.block;
+        let g = self.rc.p.gravity;
+        let mut k = 0.0;
+        let mut u = 0.0;
+        for i in from..to {
+            let (q, v) = self.state(i);
+            k += 0.5 * b.mass * (v[0] * v[0] + v[1] * v[1]) + 0.5 * b.inertia() * v[2] * v[2];
+            u += b.mass * g * q[1];
+        }
+        (k, u)
+    }
+
+    /// Configuration and velocity of block i (reads the window state).
+    pub(super) fn state(&self, i: usize) -> ([f64; 3], [f64; 3]) {
+        if i >= self.lo && i < self.hi {
+            let k = 6 * (i - self.lo);
+            (
+                [self.y[k], self.y[k + 1], self.y[k + 2]],
+                [self.y[k + 3], self.y[k + 4], self.y[k + 5]],
+            )
+        } else {
+            (self.pos[i], self.vel[i])
+        }
+    }
+
+    /// Writes the window state back to `pos`/`vel`.
+    pub(super) fn sync_out(&mut self) {
+        for i in self.lo..self.hi {
+            let k = 6 * (i - self.lo);
+            self.pos[i] = [self.y[k], self.y[k + 1], self.y[k + 2]];
+            self.vel[i] = [self.y[k + 3], self.y[k + 4], self.y[k + 5]];
+        }
+    }
+
+    /// Rebuilds the window state from `pos`/`vel`.
+    pub(super) fn sync_in(&mut self) {
+        self.y.clear();
+        for i in self.lo..self.hi {
+            self.y.extend_from_slice(&self.pos[i]);
+            self.y.extend_from_slice(&self.vel[i]);
+        }
+        self.y.push(0.0);
+    }
+
+    pub(super) fn view(&self) -> View<'_> {
+        View {
+            lo: self.lo,
+            hi: self.hi,
+            y: &self.y,
+            pos: &self.pos,
+        }
+    }
+
+    /// Every (block, slot) pair that can involve a moving block, sorted by block.
+    pub(super) fn for_each_slot(&self, mut f: impl FnMut(usize, usize)) {
+        let lambda = self.rc.p.lambda_points;
+        let first = self.lo.saturating_sub(1);
+        for i in first..self.hi.min(self.row.n) {
+            if i >= self.lo {
+                for slot in 0..=lambda {
+                    f(i, slot);
+                }
+            }
+            if i + 1 < self.row.n {
+                f(i, lambda + 1);
+            }
+            // The heel of block i+1 on the front face of block i: by default
+            // only for the last pair, where the last block lies on the ground.
+            // Inside the row the pair converges to face-to-face contact at the
+            // rest angle, where the two corner contacts make the contact and
+            // impact problems degenerate (the paper's model has only A_i and
+            // B_i there); `Settings::heel_contacts` turns them on everywhere.
+            if i + 2 == self.row.n || (self.s.heel_contacts && i + 1 < self.row.n) {
+                f(i, lambda + 2);
+            }
+        }
+    }
+
+    /// Freezes blocks at rest at the back of the window.
+    pub(super) fn freeze(&mut self) -> Result<bool, EngineError> {
+        let vf = self.s.freeze_tolerance * self.rc.p.speed_scale();
+        let af = self.s.freeze_tolerance * self.rc.p.gravity;
+        let h = self.rc.p.block.height;
+        let mut changed = false;
+        let base = self.lo;
+        self.sync_out();
+        while self.lo < self.hi {
+            let v = self.vel[self.lo];
+            let a = self.dynamics.acc[self.lo - base];
+            let slow = v[0].abs() < vf && v[1].abs() < vf && (v[2] * h).abs() < vf;
+            let still = a[0].abs() < af && a[1].abs() < af && (a[2] * h).abs() < af;
+            if !(slow && still) {
+                break;
+            }
+            let b = &self.rc.p.block;
+            self.energy.frozen +=
+                0.5 * b.mass * (v[0] * v[0] + v[1] * v[1]) + 0.5 * b.inertia() * v[2] * v[2];
+            self.vel[self.lo] = [0.0; 3];
+            self.lo += 1;
+            changed = true;
+        }
+        if changed {
+            self.rebuild_window()?;
+        }
+        Ok(changed)
+    }
+
+    /// After lo/hi changed: drops contacts without a moving block, rebuilds the
+    /// state vector and the derivative.
+    pub(super) fn rebuild_window(&mut self) -> Result<(), EngineError> {
+        let (lo, hi) = (self.lo, self.hi);
+        let lambda = self.rc.p.lambda_points;
+        self.new_active.clear();
+        for a in &self.active {
+            let moving = |j: usize| j >= lo && j < hi;
+            let keep = if a.slot <= lambda {
+                moving(a.block)
+            } else {
+                moving(a.block) && moving(a.block + 1)
+            };
+            if keep {
+                self.new_active.push(*a);
+            }
+        }
+        self.set_active();
+        self.sync_in();
+        self.eval_k0()
+    }
+}
