@@ -195,7 +195,12 @@ impl PlasticSolver {
             let new_pn = (pn - self.rate(&r, r.n, r.a_rn, r.b_rn) * r.inv_w_nn).max(0.0);
             self.push(r.a, r.b, r.n, [r.a_rn, r.b_rn], new_pn - pn);
             let free_pt = pt - self.rate(&r, r.t, r.a_rt, r.b_rt) * r.inv_w_tt;
-            let new_pt = if free_pt.abs() <= r.stick_friction * new_pn {
+            // the cone |P_t| ≤ μ_s P_n; without a normal impulse there is no
+            // friction, also for μ = ∞ (a no-slip pair), where ∞ · 0 would
+            // give NaN
+            let new_pt = if new_pn <= 0.0 {
+                0.0
+            } else if free_pt.abs() <= r.stick_friction * new_pn {
                 free_pt
             } else {
                 free_pt.signum() * r.friction * new_pn
@@ -326,5 +331,35 @@ mod tests {
         for r in &solver.rows {
             assert!(solver.rate(r, r.n, r.a_rn, r.b_rn) > -1e-9);
         }
+    }
+
+    /// A no-slip contact (μ = ∞) that takes no normal impulse: a ball moving
+    /// away from the ground sideways while a second contact stops it. The
+    /// separating contact carries nothing (∞ · 0 must not become NaN), the
+    /// other stops the ball dead (closed form: v = 0).
+    #[test]
+    fn a_no_slip_contact_without_load_carries_no_friction() {
+        let bodies = [Body::new(1.0, 0.004)
+            .with_position([0.0, 0.1])
+            .with_velocity([1.0, 0.5])];
+        let ground = Contact::new(
+            [None, Some(0)],
+            [0.0, 0.0],
+            [0.0, 1.0],
+            ContactMaterial::hertz(1e8).no_slip(),
+        );
+        let wall = Contact::new(
+            [Some(0), None],
+            [0.1, 0.1],
+            [1.0, 0.0],
+            ContactMaterial::hertz(1e8),
+        );
+        let mut out = ImpactOutcome::default();
+        PlasticSolver::default().solve_into(&bodies, &[ground, wall], &mut out);
+        let v = out.bodies[0];
+        assert!(v.velocity.iter().all(|x| x.is_finite()), "{v:?}");
+        assert_eq!(out.contacts[0].normal_impulse, 0.0);
+        assert_eq!(out.contacts[0].tangent_impulse, 0.0);
+        assert!(v.velocity[0].abs() < 1e-12 && (v.velocity[1] - 0.5).abs() < 1e-12);
     }
 }
