@@ -194,13 +194,7 @@ impl Engine {
             dynamics: Dynamics::default(),
             stages: Stages::default(),
             solver: GroupSolver::default(),
-            // the reference's own budgets: the held retry after
-            // `held_retry_after` impulse steps, every attempt within the
-            // resolver's step limit
-            policy: FallbackPolicy {
-                held_retry_after: settings.held_retry_after,
-                max_steps: settings.impact.max_steps,
-            },
+            policy: impact_policy(settings),
             impact_buffers: ImpactBuffers::default(),
             hit: vec![None; n],
             energy: EnergyReport::default(),
@@ -244,6 +238,19 @@ impl Engine {
         e.sync_in();
         e.energy.initial = e.total_energy();
         Ok(e)
+    }
+}
+
+/// The fallback policy with the reference's own budgets: the held retry
+/// after `held_retry_after` impulse steps, every attempt within the
+/// resolver's step limit.
+/// Any other budget of the policy stays at its default.
+#[allow(clippy::needless_update)] // the policy may gain budgets
+fn impact_policy(settings: &Settings) -> FallbackPolicy {
+    FallbackPolicy {
+        held_retry_after: settings.held_retry_after,
+        max_steps: settings.impact.max_steps,
+        ..FallbackPolicy::default()
     }
 }
 
