@@ -5,7 +5,9 @@
 
 use topple::impact::audit::{check, AuditSummary};
 use topple::impact::{Body, BodyVelocity, Contact, ContactImpulse, ContactMaterial, ImpactOutcome};
-use topple::stress::{draw, run_combo, violations, RowWatch, StressEngine};
+use topple::stress::{
+    draw, run_combo, violations, Kind, RowWatch, StressEngine, SweepResult, Violation,
+};
 
 /// Two equal balls (m = 1 kg, r = 0.1 m) in line, the first at 1 m/s.
 fn pair() -> (Vec<Body>, Vec<Contact>) {
@@ -70,19 +72,19 @@ fn energy_creation_momentum_loss_and_wrong_velocities_are_caught() {
 fn overlap_and_a_fallen_block_standing_up_are_seen() {
     // blocks 0.1 m × 0.02 m, the second 5 mm into the first
     let mut w = RowWatch::new(0.1, 0.02);
-    w.look(&[[0.0, 0.05, 0.0], [0.015, 0.05, 0.0]]);
+    w.look(0.0, &[[0.0, 0.05, 0.0], [0.015, 0.05, 0.0]]);
     assert!((w.seen.penetration - 0.05).abs() < 1e-12, "{:?}", w.seen);
     // a block 1 cm into the ground
     let mut w = RowWatch::new(0.1, 0.02);
-    w.look(&[[0.0, 0.04, 0.0]]);
+    w.look(0.0, &[[0.0, 0.04, 0.0]]);
     assert!((w.seen.penetration - 0.1).abs() < 1e-12);
     // fallen (tilt 1 rad > π/4), then upright again
     let mut w = RowWatch::new(0.1, 0.02);
-    w.look(&[[0.0, 0.05, -1.0]]);
-    w.look(&[[0.0, 0.05, 0.0]]);
+    w.look(0.0, &[[0.0, 0.05, -1.0]]);
+    w.look(0.0, &[[0.0, 0.05, 0.0]]);
     assert_eq!(w.seen.fallen_drop, 1);
     let mut w = RowWatch::new(0.1, 0.02);
-    w.look(&[[0.0, f64::NAN, 0.0]]);
+    w.look(0.0, &[[0.0, f64::NAN, 0.0]]);
     assert!(w.seen.non_finite);
 }
 
@@ -97,4 +99,78 @@ fn a_few_combinations_of_every_engine_pass() {
             assert!(o.hits >= 1, "{:?}", o);
         }
     }
+}
+
+#[test]
+fn native_rapier_is_the_baseline_and_not_counted() {
+    let v = |engine, kind| Violation {
+        combo: 0,
+        engine,
+        kind,
+        value: 1.0,
+        detail: String::new(),
+    };
+    let r = SweepResult {
+        violations: vec![
+            v(StressEngine::Native, Kind::Penetration),
+            v(StressEngine::Native, Kind::FallenDrop),
+            v(StressEngine::RapierF32, Kind::Penetration),
+        ],
+        ..SweepResult::default()
+    };
+    assert_eq!(r.counted().count(), 1);
+    assert_eq!(r.baseline().count(), 2);
+    assert!(r.counted().all(|v| v.engine == StressEngine::RapierF32));
+    // every engine but native counts
+    for e in StressEngine::ALL {
+        assert_eq!(e.is_baseline(), e == StressEngine::Native, "{e:?}");
+        assert_eq!(StressEngine::by_name(e.name()), Some(e));
+    }
+}
+
+#[test]
+fn a_block_lying_on_one_that_is_not_its_neighbour_is_seen() {
+    // blocks 0.1 m × 0.02 m: the third lies flat across the first, 4 mm deep
+    let mut w = RowWatch::new(0.1, 0.02);
+    let flat = std::f64::consts::FRAC_PI_2;
+    w.look(
+        0.5,
+        &[[0.0, 0.05, 0.0], [0.3, 0.05, 0.0], [0.0, 0.106, flat]],
+    );
+    assert!((w.seen.penetration - 0.04).abs() < 1e-9, "{:?}", w.seen);
+    assert!(w.seen.penetration_at.starts_with("blocks 1/3"));
+    assert!(w.seen.penetration_at.contains("t = 0.5000 s"));
+    assert_eq!(w.seen.deepest.len(), 1);
+}
+
+#[test]
+fn scene_draws_stay_in_their_ranges_and_rerun_to_the_same_bits() {
+    use topple::stress::scene::{draw_scene, run_scene_combo, SceneKind};
+    let mut kinds = Vec::new();
+    for index in 0..30 {
+        let c = draw_scene(3, index, 3, 8, 0.2);
+        kinds.push(c.kind);
+        let s = &c.scene;
+        // 1/240 s to 1/30 s; metres to pixels at 100 px/m; 10⁻² to 10² kg
+        assert!((1.0 / 240.0 - 1e-12..=1.0 / 30.0 + 1e-12).contains(&s.solver.dt));
+        assert!((1.0..=100.0).contains(&c.unit));
+        assert!((s.gravity[1] / -9.81 - c.unit).abs() < 1e-9 * c.unit);
+        for b in s.bodies.iter().filter(|b| !b.fixed) {
+            let m = b.mass.expect("every free body has its mass");
+            assert!((1e-2..=1e2).contains(&m), "{m}");
+        }
+        // nothing starts below the ground
+        assert!(s.bodies.iter().all(|b| b.position[1] > 0.0 || b.fixed));
+        // the same index draws the same scene
+        let again = draw_scene(3, index, 3, 8, 0.2);
+        assert_eq!(format!("{:?}", again.scene), format!("{:?}", c.scene));
+    }
+    for k in SceneKind::ALL {
+        assert!(kinds.contains(&k), "{k:?} drawn");
+    }
+    // a short scene run twice gives the same bits
+    let c = draw_scene(3, 0, 3, 4, 0.1);
+    let o = run_scene_combo(&c, 60.0);
+    assert!(o.error.is_none() && o.frames > 0, "{o:?}");
+    assert_eq!(o.repeat_hash, Some(o.hash));
 }

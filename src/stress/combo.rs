@@ -64,6 +64,23 @@ impl StressEngine {
         StressEngine::Impact,
     ];
 
+    /// Native Rapier is the baseline topple is measured against: its
+    /// violations are printed next to topple's, never counted in the exit
+    /// status.
+    pub fn is_baseline(self) -> bool {
+        self == StressEngine::Native
+    }
+
+    /// The engine of combination `index` (the engines take turns).
+    pub fn of_combo(index: usize) -> StressEngine {
+        StressEngine::ALL[index % StressEngine::ALL.len()]
+    }
+
+    /// The engine called `name` in the table, if any.
+    pub fn by_name(name: &str) -> Option<StressEngine> {
+        StressEngine::ALL.into_iter().find(|e| e.name() == name)
+    }
+
     /// Its name in the table.
     pub fn name(self) -> &'static str {
         match self {
@@ -103,7 +120,7 @@ pub struct Combo {
 pub fn draw(seed: u64, index: usize, n_lo: usize, n_hi: usize) -> Combo {
     let mut g = SplitMix64::new(seed ^ (index as u64).wrapping_mul(0xD1B5_4A32_D192_ED03));
     g.next_u64();
-    let engine = StressEngine::ALL[index % StressEngine::ALL.len()];
+    let engine = StressEngine::of_combo(index);
     let (preset, p) = match g.pick(&['X', 'T', 'P']) {
         'X' => ('X', Preset::X.params()),
         'T' => ('T', Preset::T.params()),

@@ -29,6 +29,17 @@ pub fn run_combo(c: &Combo, budget: f64) -> Observation {
     seen.wall = start.elapsed().as_secs_f64();
     seen.over_budget |= seen.wall > budget;
     seen.audit = audit::finish();
+    // A block can stand back up past the fallen tilt by physics: one that
+    // first meets its neighbour near π/4 (s/h near 0.6) rebounds off it, a
+    // leaning train at small spacing rocks about its rest angle near π/4.
+    // The same row in the reference engine decides (after the audit: its
+    // impacts are not this run's). It runs up to the last hit, so a drop
+    // after it stays counted.
+    if seen.fallen_drop > 0 && c.engine != StressEngine::Reference {
+        let oracle = reference(c, budget);
+        seen.reference_fallen_drop =
+            (oracle.error.is_none() && !oracle.over_budget).then_some(oracle.fallen_drop);
+    }
     seen
 }
 
@@ -59,7 +70,7 @@ fn reference(c: &Combo, budget: f64) -> Observation {
         Ok(out) => {
             for s in &out.snapshots {
                 // the reference's y is the centre height; φ counter-clockwise
-                watch.look(&s.blocks);
+                watch.look(s.time, &s.blocks);
             }
             let r = &out.report;
             watch.seen.hits = r.hit_times.len();
@@ -144,7 +155,7 @@ macro_rules! rapier_runner {
                         f64::from(p.rotation.angle()),
                     ];
                 }
-                watch.look(&blocks);
+                watch.look(sw.time, &blocks);
                 if watch.seen.non_finite {
                     break;
                 }

@@ -18,17 +18,21 @@
 //! ```no_run
 //! use topple::stress::{sweep, table, SweepSpec};
 //! let spec = SweepSpec::quick(1);
-//! let r = sweep(&spec, None, || {});
+//! let r = sweep(&spec, None, |_, _| {});
 //! println!("{}", table(&spec, &r));
-//! assert!(r.violations.is_empty());
+//! assert_eq!(r.counted().count(), 0);
 //! ```
 
 mod combo;
 mod engines;
 mod observe;
+pub mod scene;
+pub mod soak;
 mod sweep;
 
 pub use combo::{draw, reproduce, Combo, SplitMix64, StressEngine};
 pub use engines::run_combo;
 pub use observe::{Observation, RowWatch, FALLEN_TILT};
-pub use sweep::{sweep, table, tolerance, violations, Kind, SweepResult, SweepSpec, Violation};
+pub use sweep::{
+    combos_of, sweep, table, tolerance, violations, Kind, SweepResult, SweepSpec, Violation,
+};

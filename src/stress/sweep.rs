@@ -24,6 +24,8 @@ pub struct SweepSpec {
     pub budget: f64,
     /// The full sweep (for the reproduce line).
     pub full: bool,
+    /// Only the combinations of this engine (all if `None`).
+    pub engine: Option<StressEngine>,
 }
 
 impl SweepSpec {
@@ -36,6 +38,7 @@ impl SweepSpec {
             n_hi: 8,
             budget: 60.0,
             full: false,
+            engine: None,
         }
     }
 
@@ -48,6 +51,7 @@ impl SweepSpec {
             n_hi: 20,
             budget: 120.0,
             full: true,
+            engine: None,
         }
     }
 }
@@ -69,6 +73,12 @@ pub enum Kind {
     Penetration,
     /// The count of fallen blocks went down.
     FallenDrop,
+    /// A body went through the ground (scenes).
+    ThroughGround,
+    /// A frame's impact work went over the frame budget (scenes).
+    FrameWork,
+    /// A second run of the same input gave other bits (scenes).
+    Repeat,
     /// The run did not end within its budget.
     Budget,
     /// The engine returned an error.
@@ -86,6 +96,9 @@ impl Kind {
             Kind::Impulses => "velocities ≠ impulses",
             Kind::Penetration => "penetration",
             Kind::FallenDrop => "fallen count dropped",
+            Kind::ThroughGround => "through the ground",
+            Kind::FrameWork => "over the frame budget",
+            Kind::Repeat => "other bits on a rerun",
             Kind::Budget => "over budget",
             Kind::Error => "engine error",
         }
@@ -180,7 +193,8 @@ pub fn violations(c: &Combo, o: &Observation) -> Vec<Violation> {
     } else {
         pen_tol
     };
-    let fallen_drop = if dissipative {
+    // a drop the reference shows on the same row too is physics
+    let fallen_drop = if dissipative && o.reference_fallen_drop.is_none_or(|d| d == 0) {
         o.fallen_drop as f64
     } else {
         0.0
@@ -251,20 +265,48 @@ pub struct SweepResult {
     pub longest_run: f64,
     /// Worst penetration (over h) per engine and time step (µs).
     pub penetration: BTreeMap<(StressEngine, u64), f64>,
+    /// The combination and what it showed, when one alone was run.
+    pub single: Option<(Combo, Observation)>,
 }
 
-/// Runs combinations `which` (all of the spec's if `None`) and gathers the result.
-pub fn sweep(spec: &SweepSpec, which: Option<usize>, progress: impl Fn() + Sync) -> SweepResult {
-    let indices: Vec<usize> = match which {
+impl SweepResult {
+    /// The violations of topple's engines: what the exit status counts
+    /// (native Rapier's are the baseline, see [`StressEngine::is_baseline`]).
+    pub fn counted(&self) -> impl Iterator<Item = &Violation> {
+        self.violations.iter().filter(|v| !v.engine.is_baseline())
+    }
+
+    /// The violations of the baseline (native Rapier).
+    pub fn baseline(&self) -> impl Iterator<Item = &Violation> {
+        self.violations.iter().filter(|v| v.engine.is_baseline())
+    }
+}
+
+/// The combinations a sweep runs: `which` alone, or all of the spec's (of
+/// its engine, if it names one).
+pub fn combos_of(spec: &SweepSpec, which: Option<usize>) -> Vec<usize> {
+    match which {
         Some(i) => vec![i],
-        None => (0..spec.combos).collect(),
-    };
+        None => (0..spec.combos)
+            .filter(|&i| spec.engine.is_none_or(|e| StressEngine::of_combo(i) == e))
+            .collect(),
+    }
+}
+
+/// Runs combinations `which` (all of the spec's if `None`) and gathers the
+/// result; `progress` is called after each run with what it observed.
+pub fn sweep(
+    spec: &SweepSpec,
+    which: Option<usize>,
+    progress: impl Fn(&Combo, &Observation) + Sync,
+) -> SweepResult {
+    let indices = combos_of(spec, which);
     let observed: Vec<(Combo, Observation)> = indices
         .par_iter()
         .map(|&i| {
             let c = draw(spec.seed, i, spec.n_lo, spec.n_hi);
             let o = run_combo(&c, spec.budget);
-            progress();
+            progress(&c, &o);
             (c, o)
         })
         .collect();
@@ -294,10 +336,27 @@ pub fn sweep(spec: &SweepSpec, which: Option<usize>, progress: impl Fn() + Sync)
         }
         r.violations.extend(violations(c, o));
     }
+    if which.is_some() {
+        r.single = observed.into_iter().next();
+    }
     r
 }
 
-/// The table of a sweep (plain text).
+/// The kinds of violation, in the order of the table.
+const KINDS: [Kind; 9] = [
+    Kind::NonFinite,
+    Kind::EnergyGain,
+    Kind::ElasticEnergy,
+    Kind::Momentum,
+    Kind::Impulses,
+    Kind::Penetration,
+    Kind::FallenDrop,
+    Kind::Budget,
+    Kind::Error,
+];
+
+/// The table of a sweep (plain text): topple's engines, whose violations
+/// count, and native Rapier's as the baseline beside them.
 pub fn table(spec: &SweepSpec, r: &SweepResult) -> String {
     use std::fmt::Write;
     let mut s = String::new();
@@ -307,9 +366,6 @@ pub fn table(spec: &SweepSpec, r: &SweepResult) -> String {
         "seed {}  combinations {total}  impacts checked {}  (e = 1 frictionless free impacts {})",
         spec.seed, r.impacts, r.elastic_impacts
     );
-    for (e, n) in &r.runs {
-        let _ = writeln!(s, "  {:<11} {n} runs", e.name());
-    }
     let _ = writeln!(
         s,
         "longest run {:.1} s (budget {} s)",
@@ -317,21 +373,37 @@ pub fn table(spec: &SweepSpec, r: &SweepResult) -> String {
     );
     let _ = writeln!(
         s,
-        "{:<24} {:>10} {:>12}  tolerance",
-        "invariant", "violations", "worst"
+        "{:<11} {:>5} {:>10}  worst penetration / h",
+        "engine", "runs", "violations"
     );
-    for kind in [
-        Kind::NonFinite,
-        Kind::EnergyGain,
-        Kind::ElasticEnergy,
-        Kind::Momentum,
-        Kind::Impulses,
-        Kind::Penetration,
-        Kind::FallenDrop,
-        Kind::Budget,
-        Kind::Error,
-    ] {
-        let count = r.violations.iter().filter(|v| v.kind == kind).count();
+    for (e, n) in &r.runs {
+        let count = r.violations.iter().filter(|v| v.engine == *e).count();
+        let worst = r
+            .penetration
+            .iter()
+            .filter(|((pe, _), _)| pe == e)
+            .map(|(_, w)| *w)
+            .fold(None, |a: Option<f64>, w| Some(a.map_or(w, |a| a.max(w))));
+        let _ = writeln!(
+            s,
+            "{:<11} {n:>5} {count:>10}  {}{}",
+            e.name(),
+            worst.map_or("-".into(), |w| format!("{w:.2e}")),
+            if e.is_baseline() {
+                "  (baseline, not counted)"
+            } else {
+                ""
+            }
+        );
+    }
+    let _ = writeln!(
+        s,
+        "{:<24} {:>10} {:>10} {:>12}  tolerance",
+        "invariant", "topple", "baseline", "worst"
+    );
+    for kind in KINDS {
+        let count = r.counted().filter(|v| v.kind == kind).count();
+        let base = r.baseline().filter(|v| v.kind == kind).count();
         let worst = r
             .worst
             .get(&kind)
@@ -349,18 +421,22 @@ pub fn table(spec: &SweepSpec, r: &SweepResult) -> String {
             ),
             _ => "0".into(),
         };
-        let _ = writeln!(s, "{:<24} {count:>10} {worst:>12}  {tol}", kind.name());
+        let _ = writeln!(
+            s,
+            "{:<24} {count:>10} {base:>10} {worst:>12}  {tol}",
+            kind.name()
+        );
     }
     let _ = writeln!(s, "worst penetration / h by engine and time step:");
     for ((e, us), w) in &r.penetration {
         let _ = writeln!(s, "  {:<11} dt {:>6} µs  {w:.2e}", e.name(), us);
     }
     // the worst violation: the largest measure of the first kind violated
-    if let Some(v) = r
-        .violations
-        .iter()
-        .min_by(|a, b| a.kind.cmp(&b.kind).then(b.value.total_cmp(&a.value)))
-    {
+    let worst_of = |v: &mut dyn Iterator<Item = &Violation>| -> Option<Violation> {
+        v.min_by(|a, b| a.kind.cmp(&b.kind).then(b.value.total_cmp(&a.value)))
+            .cloned()
+    };
+    if let Some(v) = worst_of(&mut r.counted()) {
         let _ = writeln!(
             s,
             "worst: {} = {:.3e} in {}",
@@ -370,7 +446,16 @@ pub fn table(spec: &SweepSpec, r: &SweepResult) -> String {
         );
         let _ = writeln!(s, "reproduce: {}", reproduce(spec.seed, v.combo, spec.full));
     } else {
-        let _ = writeln!(s, "no violations");
+        let _ = writeln!(s, "no violations in topple's engines");
+    }
+    if let Some(v) = worst_of(&mut r.baseline()) {
+        let _ = writeln!(
+            s,
+            "baseline worst: {} = {:.3e} in {}",
+            v.kind.name(),
+            v.value,
+            v.detail
+        );
     }
     s
 }

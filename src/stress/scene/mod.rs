@@ -1,0 +1,370 @@
+//! The scene family of the stress sweep (`topple stress --family scenes`):
+//! random scenes for the Rapier plugin — piles, stacks and pyramids of every
+//! shape the scene format supports, random sizes, masses from 10⁻² to
+//! 10² kg, length units from metres to pixels, time steps from 1/240 to
+//! 1/30 s, both Rapier builds — each run twice and checked frame by frame.
+//!
+//! | item | file | role |
+//! | --- | --- | --- |
+//! | [`draw_scene`], [`SceneCombo`], [`SHAPES`] | `draw.rs` | the seeded draw of one scene |
+//! | [`run_scene_combo`], [`SceneObservation`] | `run.rs` | one scene through its engine, watched, and again for its bits |
+//! | [`scene_sweep`], [`scene_table`], [`scene_violations`] | `mod.rs` | many scenes in parallel; the violations and the table |
+//!
+//! ```no_run
+//! use topple::stress::scene::{scene_sweep, scene_table, SceneSpec};
+//! let spec = SceneSpec::quick(1);
+//! let r = scene_sweep(&spec, None, |_, _| {});
+//! println!("{}", scene_table(&spec, &r));
+//! ```
+
+mod draw;
+pub(super) mod run;
+
+use std::collections::BTreeMap;
+
+use rayon::prelude::*;
+
+pub use draw::{draw_scene, SceneCombo, SceneEngine, SceneKind, StressShape, SHAPES};
+pub use run::{run_scene_combo, SceneObservation};
+
+use super::sweep::{Kind, Violation};
+use super::StressEngine;
+
+/// The size of a scene sweep.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SceneSpec {
+    /// Seed of every draw.
+    pub seed: u64,
+    /// Scenes.
+    pub scenes: usize,
+    /// Scenes have `n_lo..=n_hi` bodies.
+    pub n_lo: usize,
+    /// See `n_lo`.
+    pub n_hi: usize,
+    /// Simulated time of a scene (s).
+    pub duration: f64,
+    /// Wall-clock budget of one run (s).
+    pub budget: f64,
+    /// The full sweep (for the reproduce line).
+    pub full: bool,
+}
+
+impl SceneSpec {
+    /// `topple stress --family scenes --quick`: 150 scenes of 3 to 12
+    /// bodies, 2 s each.
+    pub fn quick(seed: u64) -> Self {
+        SceneSpec {
+            seed,
+            scenes: 150,
+            n_lo: 3,
+            n_hi: 12,
+            duration: 2.0,
+            budget: 60.0,
+            full: false,
+        }
+    }
+
+    /// `topple stress --family scenes --full`: 1,200 scenes of 3 to 40
+    /// bodies, 4 s each.
+    pub fn full(seed: u64) -> Self {
+        SceneSpec {
+            seed,
+            scenes: 1200,
+            n_lo: 3,
+            n_hi: 40,
+            duration: 4.0,
+            budget: 120.0,
+            full: true,
+        }
+    }
+
+    /// Draws scene `index` of this sweep.
+    pub fn draw(&self, index: usize) -> SceneCombo {
+        draw_scene(self.seed, index, self.n_lo, self.n_hi, self.duration)
+    }
+}
+
+/// Tolerances of the scene invariants (see `docs/stress.md`).
+pub mod tolerance {
+    /// Relative energy an impact may gain: round-off of the sums, the bound
+    /// the fallback policy applies.
+    pub const ENERGY_GAIN: f64 = 1e-9;
+    /// Applied against recomputed velocities, over the speed scale.
+    pub const IMPULSES: f64 = 1e-6;
+    /// Largest overlap of two bodies over the smaller one's least width.
+    pub const PENETRATION: f64 = 0.1;
+    /// Impact work of one frame at most: impulse steps × contact points,
+    /// summed over the frame's impacts (the unit of the fallback policy's
+    /// work budget).
+    pub const FRAME_WORK: u64 = 200_000;
+}
+
+/// The violations of one observed scene run.
+pub fn scene_violations(c: &SceneCombo, o: &SceneObservation) -> Vec<Violation> {
+    use tolerance::*;
+    let a = &o.audit;
+    let checks = [
+        (
+            Kind::NonFinite,
+            (o.non_finite || a.non_finite > 0) as u8 as f64,
+            0.0,
+        ),
+        (Kind::EnergyGain, a.energy_gain, ENERGY_GAIN),
+        (Kind::Impulses, a.consistency, IMPULSES),
+        (Kind::Penetration, o.penetration, PENETRATION),
+        (
+            Kind::ThroughGround,
+            o.through_ground.is_some() as u8 as f64,
+            0.0,
+        ),
+        (
+            Kind::FrameWork,
+            o.worst_frame_work as f64,
+            FRAME_WORK as f64,
+        ),
+        (
+            Kind::Repeat,
+            o.repeat_hash.is_some_and(|h| h != o.hash) as u8 as f64,
+            0.0,
+        ),
+        (Kind::Budget, o.over_budget as u8 as f64, 0.0),
+        (Kind::Error, o.error.is_some() as u8 as f64, 0.0),
+    ];
+    checks
+        .into_iter()
+        .filter(|(_, v, tol)| v.is_nan() || *v > *tol)
+        .map(|(kind, value, _)| Violation {
+            combo: c.index,
+            engine: match c.engine {
+                SceneEngine::RapierF64 => StressEngine::RapierF64,
+                SceneEngine::RapierF32 => StressEngine::RapierF32,
+                SceneEngine::Native => StressEngine::Native,
+            },
+            kind,
+            value,
+            detail: describe(c, o),
+        })
+        .collect()
+}
+
+fn describe(c: &SceneCombo, o: &SceneObservation) -> String {
+    format!(
+        "{} {} {:?} of {} bodies, {:.3} units/m, dt 1/{:.0} s: {} frames, {} impacts ({} fallbacks), worst frame work {}, penetration {:.3} ({}){}{}",
+        c.engine.name(),
+        c.kind.name(),
+        c.precision,
+        c.scene.bodies.len(),
+        c.unit,
+        1.0 / c.scene.solver.dt,
+        o.frames,
+        o.impacts,
+        o.fallbacks,
+        o.worst_frame_work,
+        o.penetration,
+        o.penetration_at,
+        o.through_ground
+            .as_deref()
+            .map(|t| format!(", through the ground: {t}"))
+            .unwrap_or_default(),
+        o.error.as_deref().map(|e| format!(", error: {e}")).unwrap_or_default(),
+    )
+}
+
+/// What a scene sweep found.
+#[derive(Clone, Debug, Default)]
+pub struct SceneResult {
+    /// Runs per engine.
+    pub runs: BTreeMap<SceneEngine, usize>,
+    /// Impacts checked.
+    pub impacts: usize,
+    /// Frames taken (first runs).
+    pub frames: usize,
+    /// Worst measures over all runs of topple's engines, per kind.
+    pub worst: BTreeMap<Kind, f64>,
+    /// Worst penetration, worst frame work and longest frame (s), per engine.
+    pub per_engine: BTreeMap<SceneEngine, (f64, u64, f64)>,
+    /// Every violation.
+    pub violations: Vec<Violation>,
+    /// Wall-clock time of the longest scene (both runs, s).
+    pub longest_run: f64,
+    /// The scene and what it showed, when one alone was run.
+    pub single: Option<(SceneCombo, SceneObservation)>,
+}
+
+impl SceneResult {
+    /// The violations of topple's engines: what the exit status counts.
+    pub fn counted(&self) -> impl Iterator<Item = &Violation> {
+        self.violations.iter().filter(|v| !v.engine.is_baseline())
+    }
+
+    /// The violations of the baseline (native Rapier).
+    pub fn baseline(&self) -> impl Iterator<Item = &Violation> {
+        self.violations.iter().filter(|v| v.engine.is_baseline())
+    }
+}
+
+/// Runs scene `which` (all of the spec's if `None`); `progress` is called
+/// after each scene.
+pub fn scene_sweep(
+    spec: &SceneSpec,
+    which: Option<usize>,
+    progress: impl Fn(&SceneCombo, &SceneObservation) + Sync,
+) -> SceneResult {
+    let indices: Vec<usize> = match which {
+        Some(i) => vec![i],
+        None => (0..spec.scenes).collect(),
+    };
+    let observed: Vec<(SceneCombo, SceneObservation)> = indices
+        .par_iter()
+        .map(|&i| {
+            let c = spec.draw(i);
+            let o = run_scene_combo(&c, spec.budget);
+            progress(&c, &o);
+            (c, o)
+        })
+        .collect();
+    let mut r = SceneResult::default();
+    for (c, o) in &observed {
+        *r.runs.entry(c.engine).or_default() += 1;
+        r.impacts += o.audit.impacts;
+        r.frames += o.frames;
+        r.longest_run = r.longest_run.max(o.wall);
+        let e = r.per_engine.entry(c.engine).or_insert((0.0, 0, 0.0));
+        e.0 = e.0.max(o.penetration);
+        e.1 = e.1.max(o.worst_frame_work);
+        e.2 = e.2.max(o.worst_frame_seconds);
+        if !c.engine.is_baseline() {
+            for (k, v) in [
+                (Kind::EnergyGain, o.audit.energy_gain),
+                (Kind::Impulses, o.audit.consistency),
+                (Kind::Penetration, o.penetration),
+                (Kind::FrameWork, o.worst_frame_work as f64),
+            ] {
+                let w = r.worst.entry(k).or_insert(0.0);
+                *w = w.max(v);
+            }
+        }
+        r.violations.extend(scene_violations(c, o));
+    }
+    if which.is_some() {
+        r.single = observed.into_iter().next();
+    }
+    r
+}
+
+/// The kinds the scene family checks, in the order of the table.
+const SCENE_KINDS: [Kind; 9] = [
+    Kind::NonFinite,
+    Kind::EnergyGain,
+    Kind::Impulses,
+    Kind::Penetration,
+    Kind::ThroughGround,
+    Kind::FrameWork,
+    Kind::Repeat,
+    Kind::Budget,
+    Kind::Error,
+];
+
+/// The table of a scene sweep (plain text).
+pub fn scene_table(spec: &SceneSpec, r: &SceneResult) -> String {
+    use std::fmt::Write;
+    let mut s = String::new();
+    let total: usize = r.runs.values().sum();
+    let shapes: Vec<&str> = SHAPES.iter().map(|s| s.name()).collect();
+    let _ = writeln!(
+        s,
+        "scenes: seed {}  scenes {total}  frames {}  impacts checked {}  shapes {}",
+        spec.seed,
+        r.frames,
+        r.impacts,
+        shapes.join(", ")
+    );
+    let _ = writeln!(
+        s,
+        "longest scene {:.1} s (budget {} s per run, two runs each)",
+        r.longest_run, spec.budget
+    );
+    let _ = writeln!(
+        s,
+        "{:<11} {:>5} {:>10} {:>12} {:>16} {:>14}",
+        "engine", "runs", "violations", "penetration", "worst frame work", "longest frame"
+    );
+    for (e, n) in &r.runs {
+        let count = r
+            .violations
+            .iter()
+            .filter(|v| v.engine.name() == e.name())
+            .count();
+        let (pen, work, secs) = r.per_engine.get(e).copied().unwrap_or_default();
+        let _ = writeln!(
+            s,
+            "{:<11} {n:>5} {count:>10} {pen:>12.3e} {work:>16} {:>12.1} ms{}",
+            e.name(),
+            1e3 * secs,
+            if e.is_baseline() {
+                "  (baseline, not counted)"
+            } else {
+                ""
+            }
+        );
+    }
+    let _ = writeln!(
+        s,
+        "{:<24} {:>10} {:>10} {:>12}  tolerance",
+        "invariant", "topple", "baseline", "worst"
+    );
+    for kind in SCENE_KINDS {
+        let count = r.counted().filter(|v| v.kind == kind).count();
+        let base = r.baseline().filter(|v| v.kind == kind).count();
+        let worst = r
+            .worst
+            .get(&kind)
+            .map(|w| format!("{w:.3e}"))
+            .unwrap_or_else(|| "-".into());
+        let tol = match kind {
+            Kind::EnergyGain => format!("{:.0e}", tolerance::ENERGY_GAIN),
+            Kind::Impulses => format!("{:.0e}", tolerance::IMPULSES),
+            Kind::Penetration => format!("{} of the least width", tolerance::PENETRATION),
+            Kind::FrameWork => format!("{} steps × contacts", tolerance::FRAME_WORK),
+            _ => "0".into(),
+        };
+        let _ = writeln!(
+            s,
+            "{:<24} {count:>10} {base:>10} {worst:>12}  {tol}",
+            kind.name()
+        );
+    }
+    let worst_of = |v: &mut dyn Iterator<Item = &Violation>| -> Option<Violation> {
+        v.min_by(|a, b| a.kind.cmp(&b.kind).then(b.value.total_cmp(&a.value)))
+            .cloned()
+    };
+    if let Some(v) = worst_of(&mut r.counted()) {
+        let _ = writeln!(
+            s,
+            "worst: {} = {:.3e} in scene {}: {}",
+            v.kind.name(),
+            v.value,
+            v.combo,
+            v.detail
+        );
+        let _ = writeln!(
+            s,
+            "reproduce: topple stress --family scenes --seed {} --combo {}{}",
+            spec.seed,
+            v.combo,
+            if spec.full { " --full" } else { "" }
+        );
+    } else {
+        let _ = writeln!(s, "no violations in topple's engines");
+    }
+    if let Some(v) = worst_of(&mut r.baseline()) {
+        let _ = writeln!(
+            s,
+            "baseline worst: {} = {:.3e} in scene {}",
+            v.kind.name(),
+            v.value,
+            v.combo
+        );
+    }
+    s
+}

@@ -1,0 +1,300 @@
+//! One scene through its engine, watched frame by frame: the drawn scenes
+//! of the sweep (run twice, for their bits) and the soak (a scene that
+//! resets itself, for hours of frames).
+
+use std::time::Instant;
+
+use super::draw::SceneCombo;
+use crate::impact::audit::{self, AuditSummary};
+use crate::rapier::scene::{Engine, Scene};
+use crate::rapier::Precision;
+
+/// What one scene run shows, measured from the bodies' states and the
+/// adapter's impact reports, independently of the engine's own counters.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct SceneObservation {
+    /// A pose or velocity became NaN or infinite.
+    pub non_finite: bool,
+    /// Largest overlap of two bodies, or of a body and the ground or a
+    /// wall, over the smaller body's least width.
+    pub penetration: f64,
+    /// Where and when the largest overlap was.
+    pub penetration_at: String,
+    /// A body whose centre went below the ground's top face: "bN at t".
+    pub through_ground: Option<String>,
+    /// Largest impact work of one frame: Σ over the frame's impacts of
+    /// impulse steps × contact points (the unit of the adapter's budget).
+    pub worst_frame_work: u64,
+    /// Frames taken.
+    pub frames: usize,
+    /// Impacts topple resolved.
+    pub impacts: usize,
+    /// Impacts the fallback policy finished (held or plastic).
+    pub fallbacks: usize,
+    /// Hash of every body state of every frame (bits), first run.
+    pub hash: u64,
+    /// The same, second run; equal unless the run is not deterministic.
+    pub repeat_hash: Option<u64>,
+    /// A run did not end within its wall-clock budget.
+    pub over_budget: bool,
+    /// Wall-clock time of both runs (s).
+    pub wall: f64,
+    /// Longest frame, wall clock (s); reported, not checked.
+    pub worst_frame_seconds: f64,
+    /// The impacts, checked independently ([`crate::impact::audit`]).
+    pub audit: AuditSummary,
+    /// The scene could not be built.
+    pub error: Option<String>,
+}
+
+/// FNV-1a over 64-bit words.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Fnv(pub u64);
+
+impl Fnv {
+    pub(crate) fn new() -> Self {
+        Fnv(0xcbf2_9ce4_8422_2325)
+    }
+    pub(crate) fn add(&mut self, x: f64) {
+        for b in x.to_bits().to_le_bytes() {
+            self.0 ^= u64::from(b);
+            self.0 = self.0.wrapping_mul(0x0100_0000_01b3);
+        }
+    }
+}
+
+/// Runs `c` twice, the first time with every impact checked and every
+/// frame watched; `budget` is the wall-clock budget of each run (s).
+pub fn run_scene_combo(c: &SceneCombo, budget: f64) -> SceneObservation {
+    let start = Instant::now();
+    let run = |watch: bool| {
+        let frames = (c.scene.duration / c.scene.solver.dt).round() as usize;
+        let mut hooks = Hooks {
+            watch,
+            budget,
+            frames,
+            ..Hooks::default()
+        };
+        match c.precision {
+            Precision::F64 => on_f64::run(&c.scene, c.rapier_engine(), &mut hooks),
+            Precision::F32 => on_f32::run(&c.scene, c.rapier_engine(), &mut hooks),
+        }
+    };
+    audit::start();
+    let mut seen = run(true);
+    seen.audit = audit::finish();
+    if seen.error.is_none() && !seen.over_budget {
+        let again = run(false);
+        seen.over_budget |= again.over_budget;
+        seen.repeat_hash = (!again.over_budget).then_some(again.hash);
+    }
+    seen.wall = start.elapsed().as_secs_f64();
+    seen
+}
+
+/// What a run does besides stepping: how many frames, whether it watches
+/// overlaps, and (for the soak) when it puts the scene back.
+#[derive(Default)]
+pub(crate) struct Hooks<'a> {
+    /// Measure overlaps every frame (else only the hash and the state).
+    pub watch: bool,
+    /// Wall-clock budget of the run (s).
+    pub budget: f64,
+    /// Frames to take.
+    pub frames: usize,
+    /// Called after every frame with the frame's index and the kinetic
+    /// energy of the scene (J); returns true to put every body back where
+    /// and as fast as the scene starts it.
+    pub reset: Option<&'a mut dyn FnMut(usize, f64) -> bool>,
+}
+
+/// One watcher per Rapier build: the scene built by the adapter, stepped
+/// frame by frame, every body checked.
+macro_rules! watcher_for {
+    ($m:ident, $adapter:ident, $backend:ident) => {
+        pub(crate) mod $m {
+            use std::time::Instant;
+
+            use super::{Fnv, Hooks, SceneObservation};
+            use crate::rapier::scene::{Engine, Scene};
+            use crate::rapier::$adapter::{build, signed_gap, SceneWorld};
+            use crate::$backend::parry::bounding_volume::BoundingVolume;
+            use crate::$backend::prelude::{ColliderHandle, RigidBodyHandle};
+
+            /// The least width of a collider: its local box's smaller side
+            /// (a box's thickness, a ball's diameter).
+            fn least_width(sw: &SceneWorld, c: ColliderHandle) -> f64 {
+                let aabb = sw.world.colliders[c].shape().compute_local_aabb();
+                let e = aabb.extents();
+                f64::from(e.x.min(e.y))
+            }
+
+            /// Runs `scene` with `engine` as `hooks` say.
+            pub(crate) fn run(
+                scene: &Scene,
+                engine: Engine,
+                hooks: &mut Hooks,
+            ) -> SceneObservation {
+                let mut seen = SceneObservation::default();
+                let mut sw = match build(scene, engine) {
+                    Ok(sw) => sw,
+                    Err(e) => {
+                        seen.error = Some(e.to_string());
+                        return seen;
+                    }
+                };
+                let handles: Vec<(RigidBodyHandle, ColliderHandle)> =
+                    sw.bodies.iter().map(|b| (b.1, b.2)).collect();
+                let sizes: Vec<f64> = handles.iter().map(|h| least_width(&sw, h.1)).collect();
+                let ground_y = scene.ground.as_ref().map_or(f64::NEG_INFINITY, |g| g.y);
+                // the ground's collider: the one no scene body owns
+                let ground = sw
+                    .world
+                    .colliders
+                    .iter()
+                    .map(|(h, _)| h)
+                    .find(|h| handles.iter().all(|b| b.1 != *h));
+                // the start of every body, to put the scene back
+                let initial: Vec<_> = handles
+                    .iter()
+                    .map(|(h, _)| {
+                        let rb = &sw.world.bodies[*h];
+                        (*rb.position(), rb.linvel(), rb.angvel())
+                    })
+                    .collect();
+                let start = Instant::now();
+                let mut hash = Fnv::new();
+                for frame in 0..hooks.frames {
+                    let t0 = Instant::now();
+                    let (work, impacts, fallbacks) = {
+                        let reports = sw.step();
+                        let work: u64 = reports
+                            .iter()
+                            .map(|r| r.steps as u64 * r.contacts as u64)
+                            .sum();
+                        let fallbacks = reports
+                            .iter()
+                            .filter(|r| r.resolution != crate::coupling::Resolution::Lzb)
+                            .count();
+                        (work, reports.len(), fallbacks)
+                    };
+                    seen.worst_frame_seconds =
+                        seen.worst_frame_seconds.max(t0.elapsed().as_secs_f64());
+                    seen.frames = frame + 1;
+                    seen.worst_frame_work = seen.worst_frame_work.max(work);
+                    seen.impacts += impacts;
+                    seen.fallbacks += fallbacks;
+                    let time = sw.time;
+                    for (k, (h, _)) in handles.iter().enumerate() {
+                        let rb = &sw.world.bodies[*h];
+                        let p = rb.position();
+                        let state = [
+                            f64::from(p.translation.x),
+                            f64::from(p.translation.y),
+                            f64::from(p.rotation.angle()),
+                            f64::from(rb.linvel().x),
+                            f64::from(rb.linvel().y),
+                            f64::from(rb.angvel()),
+                        ];
+                        if state.iter().any(|v| !v.is_finite()) {
+                            seen.non_finite = true;
+                        }
+                        for v in state {
+                            hash.add(v);
+                        }
+                        if hooks.watch && seen.through_ground.is_none() && state[1] < ground_y {
+                            seen.through_ground = Some(format!("b{} at t = {time:.3} s", k + 1));
+                        }
+                    }
+                    if seen.non_finite {
+                        break;
+                    }
+                    if hooks.watch {
+                        overlaps(&sw, &handles, &sizes, ground, time, &mut seen);
+                    }
+                    if start.elapsed().as_secs_f64() > hooks.budget {
+                        seen.over_budget = true;
+                        break;
+                    }
+                    if let Some(reset) = hooks.reset.as_mut() {
+                        if reset(frame, sw.kinetic_energy()) {
+                            for ((h, _), (pose, v, w)) in handles.iter().zip(&initial) {
+                                let rb = &mut sw.world.bodies[*h];
+                                rb.set_position(*pose, true);
+                                rb.set_linvel(*v, true);
+                                rb.set_angvel(*w, true);
+                            }
+                        }
+                    }
+                }
+                seen.hash = hash.0;
+                seen
+            }
+
+            /// Every pair of bodies whose boxes meet, and every body against
+            /// the ground: the deepest overlap over the smaller least width.
+            fn overlaps(
+                sw: &SceneWorld,
+                handles: &[(RigidBodyHandle, ColliderHandle)],
+                sizes: &[f64],
+                ground: Option<ColliderHandle>,
+                time: f64,
+                seen: &mut SceneObservation,
+            ) {
+                let w = &sw.world;
+                let aabbs: Vec<_> = handles
+                    .iter()
+                    .map(|(_, col)| w.colliders[*col].compute_aabb())
+                    .collect();
+                let mut note = |depth: f64, size: f64, what: String| {
+                    let d = depth / size;
+                    if d > seen.penetration {
+                        seen.penetration = d;
+                        seen.penetration_at = format!("{what} at t = {time:.3} s");
+                    }
+                };
+                for i in 0..handles.len() {
+                    for j in i + 1..handles.len() {
+                        if !aabbs[i].intersects(&aabbs[j]) {
+                            continue;
+                        }
+                        let gap = signed_gap(&w.bodies, &w.colliders, handles[i].1, handles[j].1);
+                        if gap < 0.0 {
+                            note(
+                                -gap,
+                                sizes[i].min(sizes[j]),
+                                format!("b{}/b{}", i + 1, j + 1),
+                            );
+                        }
+                    }
+                    if let Some(gr) = ground {
+                        let gap = signed_gap(&w.bodies, &w.colliders, gr, handles[i].1);
+                        if gap < 0.0 {
+                            note(-gap, sizes[i], format!("b{}/ground", i + 1));
+                        }
+                    }
+                }
+            }
+        }
+    };
+}
+
+watcher_for!(on_f64, f64, rapier2d_f64);
+watcher_for!(on_f32, f32, rapier2d);
+
+/// Runs `scene` with `engine` on `precision`'s build as `hooks` say, every
+/// impact checked.
+pub(crate) fn run_with(
+    scene: &Scene,
+    engine: Engine,
+    precision: Precision,
+    hooks: &mut Hooks,
+) -> SceneObservation {
+    audit::start();
+    let mut seen = match precision {
+        Precision::F64 => on_f64::run(scene, engine, hooks),
+        Precision::F32 => on_f32::run(scene, engine, hooks),
+    };
+    seen.audit = audit::finish();
+    seen
+}
