@@ -144,10 +144,12 @@ impl Settings {
     pub const FREEZE_TOLERANCE: f64 = 1e-2;
 
     /// The defaults with the paper's fixed impulse step ΔP = 10⁻⁴ P₀
-    /// (Sec. 3.1) in the impacts.
+    /// (Sec. 3.1) in the impacts, named here rather than taken from the
+    /// resolver's default so that it stays the paper's whatever that
+    /// default becomes.
     pub fn paper_impacts() -> Self {
         let mut s = Self::default();
-        s.impact.step_control = crate::impact::StepControl::default();
+        s.impact.step_control = crate::impact::StepControl::Fixed { impulse_step: 1e-4 };
         s
     }
 
