@@ -128,7 +128,11 @@ fn parse_run(run: &str, default: Precision) -> anyhow::Result<RunKind> {
         if !head.is_empty() {
             let smooth = format!("reference:{}", head.join(":"));
             let control = if *stepping == "fixed" {
-                StepControl::default()
+                StepControl::paper()
+            } else if let Some(tol) = stepping.strip_prefix("impulse-") {
+                StepControl::AdaptiveImpulse {
+                    tolerance: number(tol, "impact tolerance", run)?,
+                }
             } else {
                 StepControl::Adaptive {
                     tolerance: number(stepping, "impact tolerance", run)?,
@@ -300,6 +304,7 @@ fn default_baseline(kinds: &[(String, RunKind)]) -> Option<usize> {
         };
         let impacts = match control {
             Some(StepControl::Adaptive { tolerance }) => tolerance,
+            Some(StepControl::AdaptiveImpulse { tolerance }) => tolerance,
             Some(StepControl::Fixed { impulse_step }) => impulse_step,
             None => Settings::IMPACT_TOLERANCE,
         };
@@ -396,7 +401,10 @@ pub fn run(args: Args) -> anyhow::Result<()> {
 fn family(kind: &RunKind) -> &'static str {
     match kind {
         RunKind::Reference(_, Some(StepControl::Fixed { .. })) => "reference, fixed impulse step",
-        RunKind::Reference(..) => "reference, adaptive impulse step",
+        RunKind::Reference(_, Some(StepControl::AdaptiveImpulse { .. })) => {
+            "reference, adaptive impulse step"
+        }
+        RunKind::Reference(..) => "reference, adaptive time step",
         RunKind::Rapier { .. } => "Rapier + topple",
         RunKind::Native { .. } => "native Rapier",
     }
@@ -587,7 +595,7 @@ mod tests {
         );
         assert_eq!(
             parse_run("reference:paper:imp:fixed", Precision::F64).unwrap(),
-            RunKind::Reference(Integrator::Paper { dt: 1e-4 }, Some(StepControl::default()))
+            RunKind::Reference(Integrator::Paper { dt: 1e-4 }, Some(StepControl::paper()))
         );
         assert!(parse_run("reference:imp:1e-4", Precision::F64).is_err());
         assert!(parse_run("reference:paper:imp:-1", Precision::F64).is_err());

@@ -29,9 +29,11 @@
 
 pub mod audit;
 mod body;
+pub mod capture;
 mod contact;
 mod error;
 mod outcome;
+mod impulse;
 mod settings;
 mod solver;
 mod validate;

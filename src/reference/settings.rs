@@ -147,7 +147,7 @@ impl Settings {
     /// (Sec. 3.1) in the impacts.
     pub fn paper_impacts() -> Self {
         let mut s = Self::default();
-        s.impact.step_control = crate::impact::StepControl::default();
+        s.impact.step_control = crate::impact::StepControl::paper();
         s
     }
 
