@@ -6,14 +6,15 @@
 //!
 //! | run | meaning |
 //! | --- | --- |
-//! | `reference:paper` | reference engine, the paper's improved Euler at 10⁻⁴ s, impacts at the default adaptive impulse stepping (10⁻⁴) |
+//! | `reference:paper` | reference engine, the paper's improved Euler at 10⁻⁴ s, impacts by the time-domain resolver at its default tolerance (10⁻⁴) |
 //! | `reference:paper:DT` | the same at time step DT (s) |
 //! | `reference:TOL` | reference engine, adaptive Dormand–Prince at tolerance TOL |
-//! | `reference:…:imp:TOL` | either of the above with adaptive impulse stepping at TOL |
+//! | `reference:…:imp:TOL` | either of the above with the time-domain resolver at TOL |
+//! | `reference:…:imp:impulse-TOL` | either of the above with adaptive impulse stepping at TOL (the previous default) |
 //! | `reference:…:imp:fixed` | either of the above with the paper's fixed impulse step ΔP = 10⁻⁴ P₀ |
 //! | `rapier:DT` | Rapier with topple at its default settings, time step DT (s) |
 //! | `rapier:DT:STEP` | Rapier with topple, time step DT (s), fixed impulse step ΔP/P₀ = STEP |
-//! | `rapier:DT:tol:TOL` | Rapier with topple, adaptive impulse stepping at TOL |
+//! | `rapier:DT:tol:TOL` | Rapier with topple, impacts at tolerance TOL |
 //! | `native:DT` | Rapier's own impact response, time step DT (s) |
 //!
 //! A Rapier run (`rapier…`, `native…`) may end in `:f32` or `:f64` to choose
@@ -404,7 +405,7 @@ fn family(kind: &RunKind) -> &'static str {
         RunKind::Reference(_, Some(StepControl::AdaptiveImpulse { .. })) => {
             "reference, adaptive impulse step"
         }
-        RunKind::Reference(..) => "reference, adaptive time step",
+        RunKind::Reference(..) => "reference, impacts in time",
         RunKind::Rapier { .. } => "Rapier + topple",
         RunKind::Native { .. } => "native Rapier",
     }

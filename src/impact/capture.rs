@@ -2,7 +2,8 @@
 //! on per thread, every call of [`crate::impact::ImpactSolver::solve_into`]
 //! with valid input keeps a copy of its bodies, contacts and settings, so
 //! that the impacts of a whole scene can be solved again with other settings
-//! (`topple bench --impacts`, `cargo bench --bench impact`).
+//! (`cargo bench --bench impact` reads impacts recorded this way from
+//! benches/data/).
 //!
 //! Off (the default), a call costs one thread-local read.
 //!

@@ -6,7 +6,7 @@ use serde::{Deserialize, Serialize};
 ///
 /// ```
 /// use topple::impact::StepControl;
-/// assert_eq!(StepControl::default(), StepControl::Adaptive { tolerance: 1e-5 });
+/// assert_eq!(StepControl::default(), StepControl::Adaptive { tolerance: 2e-6 });
 /// assert_eq!(StepControl::paper(), StepControl::Fixed { impulse_step: 1e-4 });
 /// ```
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
@@ -47,7 +47,7 @@ pub enum StepControl {
 
 impl StepControl {
     /// The default tolerance of [`StepControl::Adaptive`].
-    pub const DEFAULT_TOLERANCE: f64 = 1e-5;
+    pub const DEFAULT_TOLERANCE: f64 = 2e-6;
 
     /// The paper's fixed impulse step ΔP = 10⁻⁴ P₀ (Sec. 3.1).
     pub const fn paper() -> Self {
@@ -119,7 +119,7 @@ impl Default for ImpactSettings {
 
 impl ImpactSettings {
     /// The default of [`ImpactSettings::fast_cycle`].
-    pub const FAST_CYCLE: f64 = 1e-3;
+    pub const FAST_CYCLE: f64 = 0.01;
 
     /// The paper's fixed step ΔP = `impulse_step` · P₀.
     pub fn fixed(impulse_step: f64) -> Self {

@@ -209,9 +209,7 @@ impl Constraints {
 /// Rate change of row `r` per unit force of row `c`: J_r M⁻¹ D_cᵀ (1/kg).
 fn coupling(bodies: &[BodySlot], r: &ConstraintRow, c: &ConstraintRow) -> f64 {
     // body slot, the row's sign and arm, the column's sign and arm
-    let sides = |x: &ConstraintRow, axis: &Axis| {
-        [(x.a, -1.0, axis.arm_a), (x.b, 1.0, axis.arm_b)]
-    };
+    let sides = |x: &ConstraintRow, axis: &Axis| [(x.a, -1.0, axis.arm_a), (x.b, 1.0, axis.arm_b)];
     let mut sum = 0.0;
     for (br, sr, ar) in sides(r, &r.velocity) {
         for (bc, sc, ac) in sides(c, &c.push) {

@@ -71,7 +71,11 @@ fn guard(bodies: &[Body], out: &mut ImpactOutcome) {
     if !(s > 0.0 && s < 1.0) {
         return;
     }
-    for (b, v) in bodies.iter().zip(out.bodies.iter_mut()).filter(|(b, _)| !b.fixed) {
+    for (b, v) in bodies
+        .iter()
+        .zip(out.bodies.iter_mut())
+        .filter(|(b, _)| !b.fixed)
+    {
         for k in 0..2 {
             v.velocity[k] = b.velocity[k] + s * (v.velocity[k] - b.velocity[k]);
         }

@@ -46,8 +46,12 @@ pub(super) enum Switch {
 /// applied with it (points of one flat face letting go together).
 const SAME_INSTANT: f64 = 1e-9;
 
-/// Relative width of the bracket at which the root search stops.
+/// Relative width of the bracket at which the root search stops: linear
+/// conditions (a polynomial, cheap to evaluate) and the constraint forces
+/// (each value an interpolated state and an evaluation; the step's error is
+/// far above this anyway).
 const ROOT_WIDTH: f64 = 1e-13;
+const NONLINEAR_WIDTH: f64 = 1e-7;
 
 impl Integrator {
     /// After an accepted step with suspect points or patches: the earliest
@@ -81,15 +85,31 @@ impl Integrator {
             nonlinear |= self.has_nonlinear(item);
         }
         if nonlinear {
+            // the watched rows, with the sign of each stuck patch's friction
+            // where it was seen beyond its bound (the step's end), so that
+            // each condition is smooth in θ
+            self.watched.clear();
+            for k in 0..self.suspects.len() {
+                match self.suspects[k] {
+                    Suspect::Point(i) if self.points[i].mode == PointMode::Held => {
+                        self.watched.push((self.suspects[k], 1.0));
+                    }
+                    Suspect::Patch(p) if self.patch_modes[p] == PatchMode::Stick => {
+                        let sign = self.patch_states[p].friction.signum();
+                        self.watched.push((self.suspects[k], sign));
+                    }
+                    _ => {}
+                }
+            }
             let upto = earliest.min(1.0);
             let mut state = std::mem::take(&mut self.probe_state);
             let mut slope = std::mem::take(&mut self.probe_slope);
-            let phi = |s: &mut Self, t: f64| {
+            let mut phi = |s: &mut Self, t: f64| {
                 rk.dense_state(t, &mut state);
                 s.eval(&state, &mut slope, false);
                 s.constraint_violation()
             };
-            let t = first_crossing_mut(self, phi, upto);
+            let t = first_crossing_mut(self, &mut phi, upto);
             self.probe_state = state;
             self.probe_slope = slope;
             if let Some(t) = t {
@@ -162,20 +182,20 @@ impl Integrator {
         }
     }
 
-    /// The largest violation among held forces (−λ) and stuck patches
-    /// (|f| − μ_s N) after an evaluation (N): positive once one lets go.
+    /// The largest violation among the watched held forces (−λ) and stuck
+    /// patches (s f − μ_s N, s the sign of f where it broke loose) after an
+    /// evaluation (N): positive once one lets go.
     fn constraint_violation(&self) -> f64 {
         let mut worst = f64::NEG_INFINITY;
-        for point in &self.points {
-            if point.mode == PointMode::Held {
-                worst = worst.max(-point.held_force);
-            }
-        }
-        for (p, patch) in self.patches.iter().enumerate() {
-            if self.patch_modes[p] == PatchMode::Stick && !patch.no_slip() {
-                let load = &self.patch_states[p];
-                worst = worst.max(load.friction.abs() - patch.stick_bound * load.normal);
-            }
+        for &(item, sign) in &self.watched {
+            let v = match item {
+                Suspect::Point(i) => -self.points[i].held_force,
+                Suspect::Patch(p) => {
+                    let load = &self.patch_states[p];
+                    sign * load.friction - self.patches[p].stick_bound * load.normal
+                }
+            };
+            worst = worst.max(v);
         }
         worst
     }
@@ -188,9 +208,6 @@ impl Integrator {
         self.y = y;
         self.clock.x += theta * rk.h;
         self.note_peaks();
-        if std::env::var_os("TOPPLE_TRACE").is_some() {
-            eprintln!("  land θ={theta:.3e} t={:.6e} due {:?}", self.y[self.layout.time()], self.due);
-        }
         for k in 0..self.due.len() {
             let switch = self.due[k].1;
             self.apply(switch);
@@ -230,10 +247,6 @@ impl Integrator {
             Switch::Recompresses(i) => self.points[i].mode = PointMode::Compress,
             Switch::LetsGo(i) => {
                 self.points[i].mode = PointMode::Compress;
-                if std::env::var_os("TOPPLE_TRACE").is_some() {
-                    let row = &self.rows[i];
-                    eprintln!("    letsgo {i} mode {:?} peak/qs {:.2e} rate/V {:.2e} e {}", self.points[i].mode, self.points[i].peak / row.q_scale, super::rhs::normal_rate(row, &self.y) / self.scales.velocity, row.law.restitution);
-                }
                 self.y[lay.q(i)] = 0.0;
             }
             // the segment restarts at the onset (see `Variable::Root`); a
@@ -327,6 +340,12 @@ fn first_crossing(phi: impl Fn(f64) -> f64, from: f64, upto: f64) -> Option<f64>
 }
 
 /// [`first_crossing`] for a φ that needs the integrator (four samples).
+///
+/// A condition that sits at its boundary at the start (φ(0) within 10⁻⁹ of
+/// the first positive sample, e.g. a friction force at its bound when the
+/// slip stopped) and turns positive at once is landed on right after the
+/// start (θ = 10⁻⁶ of the bracket) instead of bisecting towards θ = 0; the
+/// modes are then settled there (modes.rs), which switches it.
 fn first_crossing_mut(
     s: &mut Integrator,
     mut phi: impl FnMut(&mut Integrator, f64) -> f64,
@@ -340,8 +359,19 @@ fn first_crossing_mut(
             if !f_lo.is_finite() {
                 f_lo = phi(s, 0.0).min(0.0);
             }
+            if f_lo >= -1e-9 * f {
+                let near = lo + 1e-6 * (t - lo);
+                if phi(s, near) > 0.0 {
+                    return Some(near);
+                }
+            }
             let mut g = |t: f64| phi(s, t);
-            return Some(illinois_mut(&mut g, (lo, f_lo), (t, f)));
+            return Some(illinois_mut(
+                &mut g,
+                (lo, f_lo),
+                (t, f),
+                NONLINEAR_WIDTH * upto,
+            ));
         }
         (lo, f_lo) = (t, f);
     }
@@ -350,15 +380,22 @@ fn first_crossing_mut(
 
 fn illinois(phi: &impl Fn(f64) -> f64, lo: (f64, f64), hi: (f64, f64)) -> f64 {
     let mut g = |t: f64| phi(t);
-    illinois_mut(&mut g, lo, hi)
+    let width = ROOT_WIDTH * hi.0;
+    illinois_mut(&mut g, lo, hi, width)
 }
 
-/// Regula falsi with the Illinois halving, on a bracket with φ(lo) ≤ 0 < φ(hi).
-fn illinois_mut(phi: &mut impl FnMut(f64) -> f64, lo: (f64, f64), hi: (f64, f64)) -> f64 {
+/// Regula falsi with the Illinois halving, on a bracket with φ(lo) ≤ 0 < φ(hi),
+/// until it is at most `width` wide (in θ).
+fn illinois_mut(
+    phi: &mut impl FnMut(f64) -> f64,
+    lo: (f64, f64),
+    hi: (f64, f64),
+    width: f64,
+) -> f64 {
     let ((mut a, mut fa), (mut b, mut fb)) = (lo, hi);
     let mut side = 0;
     for _ in 0..64 {
-        if b - a <= ROOT_WIDTH * b.max(1e-300) {
+        if b - a <= width {
             break;
         }
         let t = if fb - fa > 0.0 && fa.is_finite() {

@@ -35,7 +35,10 @@ impl Axis {
     /// sliding friction along).
     pub fn minus(self, c: f64, other: Axis) -> Axis {
         Axis {
-            dir: [self.dir[0] - c * other.dir[0], self.dir[1] - c * other.dir[1]],
+            dir: [
+                self.dir[0] - c * other.dir[0],
+                self.dir[1] - c * other.dir[1],
+            ],
             arm_a: self.arm_a - c * other.arm_a,
             arm_b: self.arm_b - c * other.arm_b,
         }
@@ -49,6 +52,13 @@ pub(super) struct Row {
     pub a: usize,
     pub b: usize,
     pub normal: Axis,
+    /// The direction F pushes along: the normal, plus −μ s times the
+    /// tangent while the point's patch slides with sign s (kept by
+    /// `Integrator::set_patch`), and the friction factor −μ s itself.
+    pub drive: Axis,
+    pub slide: f64,
+    /// 1/m and 1/I of body a, then of body b (0 for fixed bodies).
+    pub inverse: [f64; 4],
     pub law: Law,
     /// Friction patch (see [`Patch`]).
     pub patch: usize,
@@ -223,10 +233,14 @@ impl Integrator {
             };
             let w_nn = self.w(a, b, &normal, &normal);
             let m = &c.material;
+            let (sa, sb) = (self.bodies[a], self.bodies[b]);
             self.rows.push(Row {
                 a,
                 b,
                 normal,
+                drive: normal,
+                slide: 0.0,
+                inverse: [sa.inv_mass, sa.inv_inertia, sb.inv_mass, sb.inv_inertia],
                 law: Law::new(m.stiffness, m.exponent, m.restitution),
                 patch: 0,
                 w_nn,
@@ -255,7 +269,8 @@ impl Integrator {
         self.patch_modes
             .resize(self.patches.len(), PatchMode::default());
         self.patch_states.clear();
-        self.patch_states.resize(self.patches.len(), Default::default());
+        self.patch_states
+            .resize(self.patches.len(), Default::default());
 
         // Scales: the largest approach speed and the compression scales.
         let mut speed: f64 = 0.0;

@@ -23,8 +23,8 @@
 //! Each change is followed by a new evaluation, until nothing changes (at
 //! most a few passes; a cap ends a cycle, which the next event resolves).
 
-use super::rhs::{normal_rate, rate};
 use super::constraints::Target;
+use super::rhs::{normal_rate, rate};
 use super::{Integrator, PatchMode, PointMode};
 
 impl Integrator {
@@ -157,6 +157,16 @@ impl Integrator {
     pub(super) fn set_patch(&mut self, p: usize, mode: PatchMode) {
         self.patch_modes[p] = mode;
         self.patch_states[p].switched_at = self.y[self.layout.time()];
+        let patch = &self.patches[p];
+        let slide = match mode {
+            PatchMode::Slide(s) => -patch.friction * s,
+            PatchMode::Idle | PatchMode::Stick => 0.0,
+        };
+        for &i in &self.members[patch.first..patch.first + patch.count] {
+            let row = &mut self.rows[i];
+            row.slide = slide;
+            row.drive = row.normal.minus(-slide, patch.tangent);
+        }
         self.constraints_dirty = true;
     }
 
@@ -169,8 +179,13 @@ impl Integrator {
         self.constraints.clear();
         for (p, patch) in self.patches.iter().enumerate() {
             if self.patch_modes[p] == PatchMode::Stick {
-                self.constraints
-                    .add(Target::Stick(p), patch.a, patch.b, patch.tangent, patch.tangent);
+                self.constraints.add(
+                    Target::Stick(p),
+                    patch.a,
+                    patch.b,
+                    patch.tangent,
+                    patch.tangent,
+                );
             }
         }
         for (i, row) in self.rows.iter().enumerate() {
@@ -195,11 +210,17 @@ impl Integrator {
         self.refresh_constraints();
         let lay = self.layout;
         let mut y = std::mem::take(&mut self.y);
-        self.constraints.project(&self.bodies, &mut y[..3 * lay.bodies]);
+        self.constraints
+            .project(&self.bodies, &mut y[..3 * lay.bodies]);
         self.y = y;
         for k in 0..self.constraints.len() {
             match self.constraints.force(k) {
-                (Target::Held(i), p) => self.y[lay.pn(i)] += p,
+                (Target::Held(i), p) => {
+                    // a held row of a sliding patch pushes along
+                    // n − μ s t: its friction impulse is booked with it
+                    self.y[lay.pn(i)] += p;
+                    self.y[lay.pt(i)] += self.rows[i].slide * p;
+                }
                 (Target::Stick(patch), p) => {
                     let patch = &self.patches[patch];
                     let members = &self.members[patch.first..patch.first + patch.count];

@@ -28,23 +28,32 @@ use super::{Integrator, PatchMode, PointMode};
 #[inline]
 pub(super) fn push(bodies: &[BodySlot], a: usize, b: usize, axis: &Axis, f: f64, acc: &mut [f64]) {
     let (sa, sb) = (&bodies[a], &bodies[b]);
-    let (ma, ia) = (sa.inv_mass * f, sa.inv_inertia * f);
-    acc[3 * a] -= ma * axis.dir[0];
-    acc[3 * a + 1] -= ma * axis.dir[1];
-    acc[3 * a + 2] -= ia * axis.arm_a;
-    let (mb, ib) = (sb.inv_mass * f, sb.inv_inertia * f);
-    acc[3 * b] += mb * axis.dir[0];
-    acc[3 * b + 1] += mb * axis.dir[1];
-    acc[3 * b + 2] += ib * axis.arm_b;
+    let inverse = [sa.inv_mass, sa.inv_inertia, sb.inv_mass, sb.inv_inertia];
+    push_with(inverse, a, b, axis, f, acc);
+}
+
+/// [`push`] with the bodies' inverse masses and inertias given.
+#[inline]
+fn push_with(inverse: [f64; 4], a: usize, b: usize, axis: &Axis, f: f64, acc: &mut [f64]) {
+    let [ma, ia, mb, ib] = inverse;
+    let pa = &mut acc[3 * a..3 * a + 3];
+    pa[0] -= ma * f * axis.dir[0];
+    pa[1] -= ma * f * axis.dir[1];
+    pa[2] -= ia * f * axis.arm_a;
+    let pb = &mut acc[3 * b..3 * b + 3];
+    pb[0] += mb * f * axis.dir[0];
+    pb[1] += mb * f * axis.dir[1];
+    pb[2] += ib * f * axis.arm_b;
 }
 
 /// Relative rate along `axis` of body `b` against body `a` in the velocities
 /// (or accelerations) `v`: dir·(v_b − v_a) + ω_b arm_b − ω_a arm_a.
 #[inline]
 pub(super) fn rate(v: &[f64], a: usize, b: usize, axis: &Axis) -> f64 {
-    axis.dir[0] * (v[3 * b] - v[3 * a]) + axis.dir[1] * (v[3 * b + 1] - v[3 * a + 1])
-        + v[3 * b + 2] * axis.arm_b
-        - v[3 * a + 2] * axis.arm_a
+    let va = &v[3 * a..3 * a + 3];
+    let vb = &v[3 * b..3 * b + 3];
+    axis.dir[0] * (vb[0] - va[0]) + axis.dir[1] * (vb[1] - va[1]) + vb[2] * axis.arm_b
+        - va[2] * axis.arm_a
 }
 
 /// Normal rate δ̇ of a row (m/s).
@@ -63,39 +72,60 @@ impl Integrator {
     }
 
     /// dy/dt at state `y` into `dy`. With `probe`, notes the points and
-    /// patches whose mode's condition fails at `y` (see [`Integrator::suspect`]).
+    /// patches whose mode's condition fails at `y` (see events.rs).
     pub(super) fn eval(&mut self, y: &[f64], dy: &mut [f64], probe: bool) {
         let lay = self.layout;
-        dy[..3 * lay.bodies].fill(0.0);
-        self.normal_forces(y, dy);
-        if !self.constraints.is_empty() {
-            self.constraints.solve(&self.bodies, dy);
-            self.constraint_forces();
+        let (acc, rest) = dy.split_at_mut(3 * lay.bodies);
+        acc.fill(0.0);
+        // 1. normal forces, with the friction of sliding patches
+        for (i, (row, point)) in self.rows.iter().zip(self.points.iter_mut()).enumerate() {
+            point.held_force = 0.0;
+            let q = y[lay.q(i)];
+            let f = match point.mode {
+                PointMode::Compress if q > 0.0 => row.law.force(q),
+                PointMode::Expand => row.law.force(q),
+                _ => 0.0,
+            };
+            point.force = f;
+            if f != 0.0 {
+                push_with(row.inverse, row.a, row.b, &row.drive, f, acc);
+            }
         }
-        self.patch_states();
-        dy[lay.time()] = 1.0;
-        for i in 0..lay.contacts {
+        // 2. constraint forces
+        if !self.constraints.is_empty() {
+            self.constraints.solve(&self.bodies, acc);
+            self.constraint_forces();
+            self.stuck_loads();
+        }
+        // 3. compressions and impulses
+        let n = lay.contacts;
+        let (dq, rest) = rest.split_at_mut(n);
+        let (dpn, rest) = rest.split_at_mut(n);
+        let (dpt, time) = rest.split_at_mut(n);
+        time[0] = 1.0;
+        for i in 0..n {
             let row = &self.rows[i];
             let point = &self.points[i];
             let rate = normal_rate(row, y);
             let normal = point.force + point.held_force;
-            dy[lay.q(i)] = match point.mode {
+            dq[i] = match point.mode {
                 PointMode::Held => 0.0,
                 PointMode::Expand => row.law.compression_rate(rate, true),
-                PointMode::Compress => row.law.compression_rate(rate, false),
+                PointMode::Compress => -rate,
             };
-            dy[lay.pn(i)] = normal;
-            dy[lay.pt(i)] = match self.patch_modes[row.patch] {
-                PatchMode::Idle => 0.0,
-                PatchMode::Slide(s) => -self.patches[row.patch].friction * s * normal,
-                PatchMode::Stick => {
-                    let load = &self.patch_states[row.patch];
-                    if load.normal > 0.0 {
-                        load.friction * normal / load.normal
-                    } else {
-                        0.0
-                    }
+            dpn[i] = normal;
+            dpt[i] = if self.patch_modes[row.patch] == PatchMode::Stick {
+                // shared in proportion to the load, or equally while the
+                // patch carries none (its rows are identical, so any share
+                // books the force the bodies received)
+                let load = &self.patch_states[row.patch];
+                if load.normal > 0.0 {
+                    load.friction * normal / load.normal
+                } else {
+                    load.friction / self.patches[row.patch].count as f64
                 }
+            } else {
+                row.slide * normal
             };
             if probe {
                 self.probe_point(i, y[lay.q(i)], rate);
@@ -103,31 +133,6 @@ impl Integrator {
         }
         if probe {
             self.probe_patches(y);
-        }
-    }
-
-    /// Normal forces of the loaded points and the friction of sliding
-    /// patches, into the accelerations.
-    fn normal_forces(&mut self, y: &[f64], acc: &mut [f64]) {
-        let lay = self.layout;
-        for i in 0..lay.contacts {
-            let row = &self.rows[i];
-            let point = &mut self.points[i];
-            point.held_force = 0.0;
-            point.force = match point.mode {
-                PointMode::Compress => row.law.force(y[lay.q(i)].max(0.0)),
-                PointMode::Expand => row.law.force(y[lay.q(i)]),
-                PointMode::Held => 0.0,
-            };
-            let f = point.force;
-            if f == 0.0 {
-                continue;
-            }
-            push(&self.bodies, row.a, row.b, &row.normal, f, acc);
-            if let PatchMode::Slide(s) = self.patch_modes[row.patch] {
-                let patch = &self.patches[row.patch];
-                push(&self.bodies, row.a, row.b, &patch.tangent, -patch.friction * s * f, acc);
-            }
         }
     }
 
@@ -143,17 +148,17 @@ impl Integrator {
         }
     }
 
-    /// Each patch's normal load N = Σ (F + λ) of its points (N).
-    fn patch_states(&mut self) {
+    /// The normal load N = Σ (F + λ) of each stuck patch (N); only stuck
+    /// patches need it (their friction is shared in proportion, and bounded
+    /// by μ_s N).
+    fn stuck_loads(&mut self) {
         for (p, patch) in self.patches.iter().enumerate() {
-            let members = &self.members[patch.first..patch.first + patch.count];
-            let load = &mut self.patch_states[p];
-            load.normal = members
-                .iter()
-                .map(|&i| self.points[i].force + self.points[i].held_force)
-                .sum();
-            if self.patch_modes[p] != PatchMode::Stick {
-                load.friction = 0.0;
+            if self.patch_modes[p] == PatchMode::Stick {
+                let members = &self.members[patch.first..patch.first + patch.count];
+                self.patch_states[p].normal = members
+                    .iter()
+                    .map(|&i| self.points[i].force + self.points[i].held_force)
+                    .sum();
             }
         }
     }
@@ -168,7 +173,9 @@ impl Integrator {
         let fails = match point.mode {
             PointMode::Compress => {
                 (rate > thr && q > row.q_load)
-                    || (point.open && q > 0.0 && (rate < -self.scales.onset || self.onset_matters(i)))
+                    || (point.open
+                        && q > 0.0
+                        && (rate < -self.scales.onset || self.onset_matters(i)))
             }
             PointMode::Expand => rate < -thr || q < -row.q_zero,
             PointMode::Held => point.held_force < 0.0,
@@ -176,6 +183,14 @@ impl Integrator {
         if fails {
             self.suspect_point(i);
         }
+    }
+
+    /// Whether any point of patch `p` carries force at the last evaluation.
+    fn patch_loaded(&self, p: usize) -> bool {
+        let patch = &self.patches[p];
+        self.members[patch.first..patch.first + patch.count]
+            .iter()
+            .any(|&i| self.points[i].force != 0.0 || self.points[i].held_force != 0.0)
     }
 
     /// Notes the patches whose mode's condition fails at a trial point.
@@ -186,8 +201,7 @@ impl Integrator {
             let fails = match self.patch_modes[p] {
                 PatchMode::Idle => false,
                 PatchMode::Slide(s) => {
-                    self.patch_states[p].normal > 0.0
-                        && s * rate(y, patch.a, patch.b, &patch.tangent) < -thr
+                    self.patch_loaded(p) && s * rate(y, patch.a, patch.b, &patch.tangent) < -thr
                 }
                 PatchMode::Stick => {
                     let load = &self.patch_states[p];

@@ -156,6 +156,19 @@ impl Rk {
     }
 }
 
+/// y₀ + h Σ_l a_sl k_l over the components of `out`.
+#[inline]
+fn stage_state(out: &mut [f64], y0: &[f64], k: &[Vec<f64>; 7], s: usize, h: f64) {
+    let a = &A[s];
+    for (j, o) in out.iter_mut().enumerate() {
+        let mut sum = 0.0;
+        for l in 0..s {
+            sum += a[l] * k[l][j];
+        }
+        *o = y0[j] + h * sum;
+    }
+}
+
 /// Multiplies dy/dt by dt/dx (nothing to do for x = t; a NaN slope makes
 /// the step's error NaN, so that it is rejected).
 #[inline]
@@ -206,15 +219,12 @@ impl Integrator {
             rk.fresh = true;
         }
         self.clear_suspects();
+        // the inner stages need only what the right-hand side reads (the
+        // velocities and compressions); the last one is the whole new state
+        let core = self.layout.q(self.layout.contacts);
         for s in 1..7 {
-            let a = &A[s];
-            for j in 0..len {
-                let mut sum = 0.0;
-                for (l, al) in a.iter().enumerate().take(s) {
-                    sum += al * rk.k[l][j];
-                }
-                rk.stage[j] = rk.y0[j] + h * sum;
-            }
+            let upto = if s == 6 { len } else { core };
+            stage_state(&mut rk.stage[..upto], &rk.y0, &rk.k, s, h);
             let (stage, k) = (&rk.stage, &mut rk.k[s]);
             self.eval(stage, k, true);
             scale(k, self.slope(x0 + C[s] * h, stage));
@@ -251,15 +261,10 @@ impl Integrator {
                 .max(err(3 * b + 2).abs() * slot.gyration);
             worst = worst.max(e / v);
         }
-        let vworst = worst;
         for (i, row) in self.rows.iter().enumerate() {
             if row.movable {
                 worst = worst.max(err(lay.q(i)).abs() / row.q_scale);
             }
-        }
-        if std::env::var_os("TOPPLE_TRACE").is_some() {
-            let qs: Vec<String> = (0..lay.contacts).map(|i| format!("{:.1e}", err(lay.q(i)).abs() / self.rows[i].q_scale / self.tolerance)).collect();
-            eprintln!("   err v {:.2e} all {:.2e} b0 {:.1e} {:.1e} {:.1e} q {:?}", vworst / self.tolerance, worst / self.tolerance, err(0)/v/self.tolerance, err(1)/v/self.tolerance, err(2)*self.bodies[0].gyration/v/self.tolerance, qs);
         }
         if rk.y1.iter().all(|x| x.is_finite()) {
             worst / self.tolerance

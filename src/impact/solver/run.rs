@@ -61,6 +61,10 @@ impl Controller {
 /// of √T at the tolerance 10⁻⁵ (T the point's time scale, law.rs).
 const ONSET_STEP: f64 = 0.3;
 
+/// A root segment goes on in time once x is this many steps past the onset
+/// (the t^α start is resolved by then).
+const ROOT_SPAN: f64 = 3.0;
+
 impl Integrator {
     /// Integrates the loaded impact to its end.
     pub(super) fn run(
@@ -107,13 +111,6 @@ impl Integrator {
             }
             rk.y0.copy_from_slice(&self.y);
             let err = self.rk_step(rk, h);
-            if std::env::var_os("TOPPLE_TRACE").is_some() && h > 1.0 {
-                let modes: Vec<_> = self.points.iter().enumerate().filter(|(i, _)| self.carries_load(*i)).map(|(i, p)| (i, p.mode, p.force, p.held_force)).collect();
-                eprintln!("modes {modes:?}");
-            }
-            if std::env::var_os("TOPPLE_TRACE").is_some() {
-                eprintln!("{:?} x={:.3e} h={:.3e} err={:.3e} t={:.4e} susp={}", self.clock.variable, self.clock.x, h, err, self.y[self.layout.time()], self.suspects.len());
-            }
             if !(err <= 1.0) {
                 out.rejected_steps += 1;
                 if err.is_nan() && matches!(self.clock.variable, Variable::End { .. }) {
@@ -165,6 +162,9 @@ impl Integrator {
                 self.pace = next;
                 if let Some(end) = self.ending_point(next) {
                     h = self.begin_end_segment(rk, end);
+                } else if self.clock.variable == Variable::Root && self.clock.x > ROOT_SPAN * h {
+                    // the onset is behind: on in time
+                    h = self.begin_time_segment(rk, next);
                 }
             }
         }
@@ -219,14 +219,22 @@ impl Integrator {
     }
 
     /// A segment to the end of the expanding point `point`, tried in one step.
+    /// Its first step: the controller's pace (s) turned into x with
+    /// dt/dx = 2σ e²/δ̇ at its start, all the way if that is further.
     fn begin_end_segment(&mut self, rk: &mut Rk, point: usize) -> f64 {
         rk.fresh = false;
+        let row = &self.rows[point];
         let sigma = self.y[self.layout.q(point)].max(0.0).sqrt();
+        let slope = 2.0 * sigma * row.law.restitution_sq() / normal_rate(row, &self.y);
         self.clock = Clock {
             variable: Variable::End { point, sigma },
             x: 0.0,
         };
-        sigma
+        if slope > 0.0 {
+            sigma.min(self.pace / slope)
+        } else {
+            sigma
+        }
     }
 
     /// The expanding point that, at its present rate, lets go first and
