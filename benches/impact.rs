@@ -1,18 +1,34 @@
-//! Work-precision of the LZB resolver: run time, steps and error
-//! against an independent compliant-model ODE, for the paper's fixed impulse
-//! step and for adaptive stepping.
+//! The LZB resolver per scene class: impulse steps per impact, time per
+//! impact and error against the converged answer, for the paper's fixed
+//! impulse step, the adaptive impulse stepping (the resolver's default
+//! before the time-domain solver) and the time-domain solver (the default),
+//! side by side in one run.
 //!
-//! Cases:
+//! Classes:
 //! - `chain10`: ten equal balls in a row, the first striking at 1 m/s,
-//!   Hertz contacts (α = 1.5, e = 1): error against the Hertz chain ODE.
+//!   Hertz contacts (α = 1.5, e = 1): error against the Hertz chain ODE
+//!   integrated in tests/common/hertz.rs.
 //! - `leaning20`: twenty blocks of a fallen domino train (Domino T size) with
 //!   ground contacts, the last one pushed, e = 1 and no friction: error against
-//!   the compliant model with frozen geometry.
-//! - `domino20`: the same train with the domino's e = 0 and friction (no ODE
-//!   exists for it): error against the resolver at ΔP = 10⁻⁶ P₀.
+//!   the compliant model with frozen geometry (tests/common/compliant.rs).
+//! - `domino20`: the same train with the domino's e = 0 and friction (a
+//!   leaning e = 0 train).
+//! - captured impacts (benches/data/, recorded with `topple::impact::capture`
+//!   from runs of the Rapier adapter at 1/60 s): `x-row` (Domino X, Table 1,
+//!   s/h 0.3: chatter of e = 0 contacts), `t-row` (ideal Domino T, s/h 0.45),
+//!   `box-on-stack` (a box landing flat on a stack, assets/scenes/box-drop-flat),
+//!   `pile` (24 impacts of assets/scenes/pile-boxes.toml, 1 to 47 contacts),
+//!   `cradle-5` (assets/scenes/cradle-5.toml).
+//!
+//! Without an ODE, the converged answer is the time-domain solver at
+//! tolerance 10⁻¹⁰ with every e = 0 cycle followed (`fast_cycle = 0`); the
+//! `check` column gives its distance from the adaptive impulse stepping at
+//! 10⁻⁸, a second way to the same answer. Errors are the largest velocity
+//! difference of any body (ω through its radius of gyration) over the
+//! impact's largest body speed, the worst over the class.
 //!
 //! `cargo bench --bench impact` prints the table first (one run per setting),
-//! then criterion times each setting.
+//! then criterion times each setting on each class.
 
 #[path = "../tests/common/compliant.rs"]
 mod compliant;
@@ -25,20 +41,32 @@ mod leaning;
 use std::time::Instant;
 
 use criterion::{criterion_group, criterion_main, Criterion};
+use topple::impact::capture::CapturedImpact;
 use topple::impact::{Body, Contact, ContactMaterial, ImpactSettings, ImpactSolver};
 
-struct Case {
-    name: &'static str,
+/// One impact and its converged answer ([vx, vy, ω] per body).
+struct Impact {
     bodies: Vec<Body>,
     contacts: Vec<Contact>,
-    /// Reference velocities [vx, vy, ω] and the speed scale errors are divided by.
     reference: Vec<[f64; 3]>,
-    speed: f64,
-    /// Lever that turns ω errors into velocity errors (m).
-    lever: f64,
 }
 
-fn chain10() -> Case {
+/// A scene class: its impacts, and the distance between two converged
+/// answers (NaN where the reference is an ODE).
+struct Class {
+    name: &'static str,
+    impacts: Vec<Impact>,
+    check: f64,
+}
+
+fn velocities(bodies: &[Body]) -> Vec<[f64; 3]> {
+    bodies
+        .iter()
+        .map(|b| [b.velocity[0], b.velocity[1], b.angular_velocity])
+        .collect()
+}
+
+fn chain10() -> Class {
     let n = 10;
     let mut v = vec![0.0; n];
     v[0] = 1.0;
@@ -67,17 +95,18 @@ fn chain10() -> Case {
             )
         })
         .collect();
-    Case {
+    Class {
         name: "chain10",
-        bodies,
-        contacts,
-        reference: expected.iter().map(|&vx| [vx, 0.0, 0.0]).collect(),
-        speed: 1.0,
-        lever: 0.0,
+        impacts: vec![Impact {
+            bodies,
+            contacts,
+            reference: expected.iter().map(|&vx| [vx, 0.0, 0.0]).collect(),
+        }],
+        check: f64::NAN,
     }
 }
 
-fn leaning(elastic: bool) -> Case {
+fn leaning(elastic: bool) -> Class {
     let (between, ground) = if elastic {
         (ContactMaterial::hertz(2.3e8), ContactMaterial::hertz(6.9e8))
     } else {
@@ -100,79 +129,164 @@ fn leaning(elastic: bool) -> Case {
         ground,
     };
     let (bodies, contacts) = group.build();
-    let reference = if elastic {
-        compliant::integrate(&bodies, &contacts, 400.0)
+    if elastic {
+        let reference = compliant::integrate(&bodies, &contacts, 400.0);
+        Class {
+            name: "leaning20",
+            impacts: vec![Impact {
+                bodies,
+                contacts,
+                reference,
+            }],
+            check: f64::NAN,
+        }
     } else {
-        let out = ImpactSolver::new()
-            .solve(&bodies, &contacts, &ImpactSettings::fixed(1e-6))
-            .unwrap();
-        out.bodies
-            .iter()
-            .map(|b| [b.velocity[0], b.velocity[1], b.angular_velocity])
-            .collect()
+        converged("domino20", vec![(bodies, contacts)])
+    }
+}
+
+/// A class whose reference is the converged solver (see the module notes).
+fn converged(name: &'static str, list: Vec<(Vec<Body>, Contacts)>) -> Class {
+    let tight = ImpactSettings {
+        fast_cycle: 0.0,
+        max_steps: 100_000_000,
+        ..ImpactSettings::adaptive(1e-10)
     };
-    Case {
-        name: if elastic { "leaning20" } else { "domino20" },
-        bodies,
-        contacts,
-        reference,
-        speed: 5.0 * 0.08,
-        lever: 0.04,
+    let second = ImpactSettings {
+        max_steps: 100_000_000,
+        ..ImpactSettings::adaptive_impulse(1e-8)
+    };
+    let mut solver = ImpactSolver::new();
+    let mut check = 0.0f64;
+    let impacts = list
+        .into_iter()
+        .map(|(bodies, contacts)| {
+            let out = solver.solve(&bodies, &contacts, &tight).unwrap();
+            let reference = velocities(&out.bodies);
+            let other = solver.solve(&bodies, &contacts, &second).unwrap();
+            let impact = Impact {
+                bodies,
+                contacts,
+                reference,
+            };
+            check = check.max(error(&impact, &velocities(&other.bodies)));
+            impact
+        })
+        .collect();
+    Class {
+        name,
+        impacts,
+        check,
     }
 }
 
-fn settings() -> Vec<(String, ImpactSettings)> {
-    let mut list = Vec::new();
-    for step in [1e-3, 1e-4, 1e-5] {
-        list.push((format!("fixed ΔP={step:e}·P₀"), ImpactSettings::fixed(step)));
-    }
-    for tol in [1e-4, 1e-6, 1e-8] {
-        list.push((
-            format!("adaptive tol={tol:e}"),
-            ImpactSettings::adaptive(tol),
-        ));
-    }
-    list
+type Contacts = Vec<Contact>;
+
+/// A class of captured impacts from benches/data/`file`.
+fn captured(name: &'static str, file: &str) -> Class {
+    let path = format!("{}/benches/data/{file}", env!("CARGO_MANIFEST_DIR"));
+    let text = std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("{path}: {e}"));
+    let list = text
+        .lines()
+        .filter(|l| !l.trim().is_empty())
+        .map(|l| {
+            let c: CapturedImpact = serde_json::from_str(l).unwrap();
+            (c.bodies, c.contacts)
+        })
+        .collect();
+    converged(name, list)
 }
 
-fn error(case: &Case, solver: &mut ImpactSolver, s: &ImpactSettings) -> (f64, usize) {
-    let out = solver.solve(&case.bodies, &case.contacts, s).unwrap();
-    let worst = out
+/// Largest velocity error of any body (ω through its radius of gyration)
+/// over the impact's largest body speed.
+fn error(impact: &Impact, got: &[[f64; 3]]) -> f64 {
+    let speed = impact
         .bodies
         .iter()
-        .zip(&case.reference)
-        .map(|(b, r)| {
-            (b.velocity[0] - r[0])
+        .filter(|b| !b.fixed)
+        .map(|b| b.velocity[0].hypot(b.velocity[1]))
+        .fold(0.0, f64::max)
+        .max(1e-300);
+    let worst = impact
+        .bodies
+        .iter()
+        .zip(got.iter().zip(&impact.reference))
+        .filter(|(b, _)| !b.fixed)
+        .map(|(b, (g, r))| {
+            let rho = (b.inertia / b.mass).sqrt();
+            (g[0] - r[0])
                 .abs()
-                .max((b.velocity[1] - r[1]).abs())
-                .max((b.angular_velocity - r[2]).abs() * case.lever)
+                .max((g[1] - r[1]).abs())
+                .max((g[2] - r[2]).abs() * rho)
         })
         .fold(0.0, f64::max);
-    (worst / case.speed, out.steps)
+    worst / speed
+}
+
+fn settings() -> Vec<(&'static str, ImpactSettings)> {
+    vec![
+        ("paper: fixed ΔP = 10⁻⁴ P₀", ImpactSettings::fixed(1e-4)),
+        (
+            "before: adaptive impulse 10⁻⁴",
+            ImpactSettings::adaptive_impulse(1e-4),
+        ),
+        ("default: in time 10⁻⁵", ImpactSettings::default()),
+    ]
+}
+
+/// Solves every impact of a class: (median steps, mean steps, worst error).
+fn measure(class: &Class, solver: &mut ImpactSolver, s: &ImpactSettings) -> (usize, f64, f64) {
+    let mut steps = Vec::new();
+    let mut worst = 0.0f64;
+    for impact in &class.impacts {
+        let out = solver.solve(&impact.bodies, &impact.contacts, s).unwrap();
+        steps.push(out.steps);
+        worst = worst.max(error(impact, &velocities(&out.bodies)));
+    }
+    let mean = steps.iter().sum::<usize>() as f64 / steps.len() as f64;
+    steps.sort_unstable();
+    (steps[steps.len() / 2], mean, worst)
 }
 
 fn bench(c: &mut Criterion) {
-    let cases = [chain10(), leaning(true), leaning(false)];
+    let classes = [
+        chain10(),
+        leaning(true),
+        leaning(false),
+        captured("x-row", "x-row-1-60.jsonl"),
+        captured("t-row", "t-row-1-60.jsonl"),
+        captured("box-on-stack", "box-on-stack.jsonl"),
+        captured("pile", "pile.jsonl"),
+        captured("cradle-5", "cradle-5.jsonl"),
+    ];
     let mut solver = ImpactSolver::new();
-    println!("\n| case | step control | steps | error / speed | time (one run) |");
-    println!("| --- | --- | ---: | ---: | ---: |");
-    for case in &cases {
+    println!(
+        "\n| class | impacts | step control | steps (median) | steps (mean) | time per impact | error / speed | check |"
+    );
+    println!("| --- | ---: | --- | ---: | ---: | ---: | ---: | ---: |");
+    for class in &classes {
         for (label, s) in settings() {
             let start = Instant::now();
-            let (err, steps) = error(case, &mut solver, &s);
-            let time = start.elapsed();
+            let (median, mean, err) = measure(class, &mut solver, &s);
+            let time = start.elapsed() / class.impacts.len() as u32;
             println!(
-                "| {} | {label} | {steps} | {err:.1e} | {time:.1?} |",
-                case.name
+                "| {} | {} | {label} | {median} | {mean:.0} | {time:.1?} | {err:.1e} | {:.0e} |",
+                class.name,
+                class.impacts.len(),
+                class.check
             );
         }
     }
-    for case in &cases {
-        let mut group = c.benchmark_group(case.name);
+    for class in &classes {
+        let mut group = c.benchmark_group(class.name);
         group.sample_size(10);
         for (label, s) in settings() {
             group.bench_function(label, |b| {
-                b.iter(|| solver.solve(&case.bodies, &case.contacts, &s).unwrap())
+                b.iter(|| {
+                    for impact in &class.impacts {
+                        solver.solve(&impact.bodies, &impact.contacts, &s).unwrap();
+                    }
+                })
             });
         }
         group.finish();

@@ -109,11 +109,12 @@ fn worst_error(settings: &ImpactSettings) -> f64 {
     worst
 }
 
+/// The default (the time-domain solver) within 10⁻⁴ of the striking speed.
 #[test]
-fn default_step_matches_hertz_chain_to_1e_3() {
+fn default_matches_hertz_chain_to_1e_4() {
     let err = worst_error(&ImpactSettings::default());
     assert!(
-        err < 1e-3,
+        err < 1e-4,
         "worst velocity error {err:.3e} (striking speed 1 m/s)"
     );
 }

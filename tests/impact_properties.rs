@@ -96,6 +96,7 @@ fn check_with(
         step_control,
         max_steps: 100_000,
         e0_hold,
+        ..ImpactSettings::default()
     };
     match ImpactSolver::new().solve(&p.bodies, &p.contacts, &settings) {
         // a jammed configuration (e.g. a body wedged between opposing

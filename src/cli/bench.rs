@@ -6,14 +6,15 @@
 //!
 //! | run | meaning |
 //! | --- | --- |
-//! | `reference:paper` | reference engine, the paper's improved Euler at 10⁻⁴ s, impacts at the default adaptive impulse stepping (10⁻⁴) |
+//! | `reference:paper` | reference engine, the paper's improved Euler at 10⁻⁴ s, impacts by the time-domain resolver at its default tolerance (10⁻⁴) |
 //! | `reference:paper:DT` | the same at time step DT (s) |
 //! | `reference:TOL` | reference engine, adaptive Dormand–Prince at tolerance TOL |
-//! | `reference:…:imp:TOL` | either of the above with adaptive impulse stepping at TOL |
+//! | `reference:…:imp:TOL` | either of the above with the time-domain resolver at TOL |
+//! | `reference:…:imp:impulse-TOL` | either of the above with adaptive impulse stepping at TOL (the previous default) |
 //! | `reference:…:imp:fixed` | either of the above with the paper's fixed impulse step ΔP = 10⁻⁴ P₀ |
 //! | `rapier:DT` | Rapier with topple at its default settings, time step DT (s) |
 //! | `rapier:DT:STEP` | Rapier with topple, time step DT (s), fixed impulse step ΔP/P₀ = STEP |
-//! | `rapier:DT:tol:TOL` | Rapier with topple, adaptive impulse stepping at TOL |
+//! | `rapier:DT:tol:TOL` | Rapier with topple, impacts at tolerance TOL |
 //! | `native:DT` | Rapier's own impact response, time step DT (s) |
 //!
 //! A Rapier run (`rapier…`, `native…`) may end in `:f32` or `:f64` to choose
@@ -128,7 +129,11 @@ fn parse_run(run: &str, default: Precision) -> anyhow::Result<RunKind> {
         if !head.is_empty() {
             let smooth = format!("reference:{}", head.join(":"));
             let control = if *stepping == "fixed" {
-                StepControl::default()
+                StepControl::paper()
+            } else if let Some(tol) = stepping.strip_prefix("impulse-") {
+                StepControl::AdaptiveImpulse {
+                    tolerance: number(tol, "impact tolerance", run)?,
+                }
             } else {
                 StepControl::Adaptive {
                     tolerance: number(stepping, "impact tolerance", run)?,
@@ -300,6 +305,7 @@ fn default_baseline(kinds: &[(String, RunKind)]) -> Option<usize> {
         };
         let impacts = match control {
             Some(StepControl::Adaptive { tolerance }) => tolerance,
+            Some(StepControl::AdaptiveImpulse { tolerance }) => tolerance,
             Some(StepControl::Fixed { impulse_step }) => impulse_step,
             None => Settings::IMPACT_TOLERANCE,
         };
@@ -396,7 +402,10 @@ pub fn run(args: Args) -> anyhow::Result<()> {
 fn family(kind: &RunKind) -> &'static str {
     match kind {
         RunKind::Reference(_, Some(StepControl::Fixed { .. })) => "reference, fixed impulse step",
-        RunKind::Reference(..) => "reference, adaptive impulse step",
+        RunKind::Reference(_, Some(StepControl::AdaptiveImpulse { .. })) => {
+            "reference, adaptive impulse step"
+        }
+        RunKind::Reference(..) => "reference, impacts in time",
         RunKind::Rapier { .. } => "Rapier + topple",
         RunKind::Native { .. } => "native Rapier",
     }
@@ -587,7 +596,7 @@ mod tests {
         );
         assert_eq!(
             parse_run("reference:paper:imp:fixed", Precision::F64).unwrap(),
-            RunKind::Reference(Integrator::Paper { dt: 1e-4 }, Some(StepControl::default()))
+            RunKind::Reference(Integrator::Paper { dt: 1e-4 }, Some(StepControl::paper()))
         );
         assert!(parse_run("reference:imp:1e-4", Precision::F64).is_err());
         assert!(parse_run("reference:paper:imp:-1", Precision::F64).is_err());

@@ -126,7 +126,7 @@ pub struct Args {
     pub engine: EngineArg,
     /// Accurate integration at this tolerance (adaptive Dormand–Prince)
     /// instead of the paper's improved Euler at --dt. With a Rapier engine:
-    /// adaptive impulse stepping at this tolerance.
+    /// the impacts' tolerance (the time-domain resolver, docs/model.md §7).
     #[arg(long, allow_hyphen_values = true)]
     pub tolerance: Option<f64>,
     /// Fixed time step of the paper's integration (s); with a Rapier engine,
@@ -146,11 +146,11 @@ pub struct Args {
     #[arg(long, allow_hyphen_values = true)]
     pub freeze_tolerance: Option<f64>,
     /// Reference engine: impacts with the paper's fixed impulse step
-    /// ΔP = STEP · P₀ (the paper: 10⁻⁴) instead of adaptive impulse
-    /// stepping.
+    /// ΔP = STEP · P₀ (the paper: 10⁻⁴) instead of the time-domain
+    /// resolver.
     #[arg(long, allow_hyphen_values = true)]
     pub impact_step: Option<f64>,
-    /// Reference engine: the tolerance of the adaptive impulse stepping
+    /// Reference engine: the tolerance of the impacts' time-domain resolver
     /// (default 10⁻⁴).
     #[arg(long, allow_hyphen_values = true, conflicts_with = "impact_step")]
     pub impact_tolerance: Option<f64>,

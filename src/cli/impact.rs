@@ -163,6 +163,7 @@ fn resolve_json(text: &str, max_steps: usize, e0_hold: bool) -> anyhow::Result<S
         step_control,
         max_steps,
         e0_hold,
+        ..ImpactSettings::default()
     };
     let out = ImpactSolver::new().solve(&bodies, &contacts, &settings)?;
     let output = Output {

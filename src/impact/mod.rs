@@ -29,8 +29,10 @@
 
 pub mod audit;
 mod body;
+pub mod capture;
 mod contact;
 mod error;
+mod impulse;
 mod outcome;
 mod settings;
 mod solver;

@@ -2,14 +2,12 @@
 
 use serde::{Deserialize, Serialize};
 
-/// How the impulse variable is stepped.
+/// How the resolver steps through an impact.
 ///
 /// ```
 /// use topple::impact::StepControl;
-/// let paper = StepControl::default();
-/// assert_eq!(paper, StepControl::Fixed { impulse_step: 1e-4 });
-/// let adaptive = StepControl::Adaptive { tolerance: 1e-6 };
-/// # let _ = adaptive;
+/// assert_eq!(StepControl::default(), StepControl::Adaptive { tolerance: 2e-6 });
+/// assert_eq!(StepControl::paper(), StepControl::Fixed { impulse_step: 1e-4 });
 /// ```
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub enum StepControl {
@@ -17,30 +15,51 @@ pub enum StepControl {
     /// ΔP = `impulse_step` · P₀ each step, P₀ being the magnitude of the linear
     /// momentum of the free bodies just before the impact (their kinetic-energy
     /// momentum scale when that is zero, see [`crate::impact::ImpactSolver`]).
+    /// Second order in ΔP; thousands of steps per impact at the paper's 10⁻⁴.
     Fixed {
         /// ΔP / P₀, dimensionless; the paper uses 10⁻⁴.
         impulse_step: f64,
     },
-    /// The paper's scheme with the impulse step chosen per step (see
-    /// `impact::solver`): each accepted step keeps its estimated local
-    /// error below `tolerance`, velocity errors relative to the largest
-    /// approach speed at the start of the impact. The step lands on every
-    /// switch (compression ends, energy runs out, gaps close, slip stops), so
-    /// a lone contact takes a few steps, and e = 0 contacts that reload after
-    /// their compression ended follow the paper's law without a step limit
-    /// in practice. The error of the result falls with the tolerance
-    /// (about 10⁻⁴ × the approach speed at `tolerance` 10⁻⁴ on domino
-    /// impacts, see `docs/reference-performance.md`).
+    /// The default: the same law written in the impact's own time, with the
+    /// compressions as state (docs/model.md §7), integrated by an embedded
+    /// Runge–Kutta pair of orders 5 and 4 whose step keeps the estimated local
+    /// error below `tolerance`; every switch of the law (compression ends,
+    /// energy runs out, a gap closes, stick and slip, a held contact lets go)
+    /// is located on the step's interpolant and the step restarts there.
+    /// Tens of steps per impact.
     Adaptive {
+        /// Local error per step, dimensionless: velocities relative to the
+        /// largest approach speed at the start of the impact, compressions
+        /// relative to the compression that would store that approach's
+        /// energy (e.g. 10⁻³ … 10⁻⁹).
+        tolerance: f64,
+    },
+    /// The paper's impulse stepping with the step chosen per step from an
+    /// estimate of its local error (topple's default before the time-domain
+    /// solver; second order, so its steps shrink as √tolerance). Kept so that
+    /// benchmarks can compare it side by side.
+    AdaptiveImpulse {
         /// Local error per step relative to the approach speed,
-        /// dimensionless (e.g. 10⁻⁴ … 10⁻⁸).
+        /// dimensionless.
         tolerance: f64,
     },
 }
 
+impl StepControl {
+    /// The default tolerance of [`StepControl::Adaptive`].
+    pub const DEFAULT_TOLERANCE: f64 = 2e-6;
+
+    /// The paper's fixed impulse step ΔP = 10⁻⁴ P₀ (Sec. 3.1).
+    pub const fn paper() -> Self {
+        StepControl::Fixed { impulse_step: 1e-4 }
+    }
+}
+
 impl Default for StepControl {
     fn default() -> Self {
-        StepControl::Fixed { impulse_step: 1e-4 }
+        StepControl::Adaptive {
+            tolerance: Self::DEFAULT_TOLERANCE,
+        }
     }
 }
 
@@ -50,6 +69,7 @@ impl Default for StepControl {
 /// use topple::impact::{ImpactSettings, StepControl};
 /// let s = ImpactSettings::adaptive(1e-6);
 /// assert_eq!(s.step_control, StepControl::Adaptive { tolerance: 1e-6 });
+/// assert_eq!(ImpactSettings::default().step_control, StepControl::default());
 /// assert!(s.max_steps > 0);
 /// ```
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
@@ -69,6 +89,21 @@ pub struct ImpactSettings {
     /// a refinement of the default.
     #[serde(default)]
     pub e0_hold: bool,
+    /// e = 0 contacts under the paper's law, time-domain solver only: a
+    /// contact that is pushed again after its compression ended goes
+    /// through load cycles; once a cycle has changed its own normal rate by
+    /// at most `fast_cycle` times the impact's velocity scale (W_ii ΔP ≤
+    /// fast_cycle · v), its next cycles are taken by their limit — held
+    /// closed by a non-negative force that keeps its rate — until that force
+    /// would pull. The limit differs from the cycles by terms of the order
+    /// of the cycle's swing W_ii ΔP (docs/model.md §8). 0: every cycle is
+    /// followed (the paper's law to the integration tolerance).
+    #[serde(default = "default_fast_cycle")]
+    pub fast_cycle: f64,
+}
+
+fn default_fast_cycle() -> f64 {
+    ImpactSettings::FAST_CYCLE
 }
 
 impl Default for ImpactSettings {
@@ -77,11 +112,15 @@ impl Default for ImpactSettings {
             step_control: StepControl::default(),
             max_steps: 10_000_000,
             e0_hold: false,
+            fast_cycle: Self::FAST_CYCLE,
         }
     }
 }
 
 impl ImpactSettings {
+    /// The default of [`ImpactSettings::fast_cycle`].
+    pub const FAST_CYCLE: f64 = 0.01;
+
     /// The paper's fixed step ΔP = `impulse_step` · P₀.
     pub fn fixed(impulse_step: f64) -> Self {
         ImpactSettings {
@@ -90,10 +129,20 @@ impl ImpactSettings {
         }
     }
 
-    /// Adaptive stepping at the given relative tolerance.
+    /// The time-domain solver at the given relative tolerance
+    /// ([`StepControl::Adaptive`]).
     pub fn adaptive(tolerance: f64) -> Self {
         ImpactSettings {
             step_control: StepControl::Adaptive { tolerance },
+            ..Default::default()
+        }
+    }
+
+    /// The impulse stepping with an error-controlled step
+    /// ([`StepControl::AdaptiveImpulse`]).
+    pub fn adaptive_impulse(tolerance: f64) -> Self {
+        ImpactSettings {
+            step_control: StepControl::AdaptiveImpulse { tolerance },
             ..Default::default()
         }
     }

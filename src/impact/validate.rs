@@ -93,13 +93,19 @@ pub(crate) fn check(
                 )));
             }
         }
-        StepControl::Adaptive { tolerance } => {
+        StepControl::Adaptive { tolerance } | StepControl::AdaptiveImpulse { tolerance } => {
             if !(tolerance > 0.0 && tolerance < 1.0) {
                 return Err(ImpactError::InvalidSettings(format!(
                     "tolerance {tolerance} is not in (0, 1)"
                 )));
             }
         }
+    }
+    if !(settings.fast_cycle >= 0.0) {
+        return Err(ImpactError::InvalidSettings(format!(
+            "fast_cycle {} is not >= 0",
+            settings.fast_cycle
+        )));
     }
     if settings.max_steps == 0 {
         return Err(ImpactError::InvalidSettings("max_steps is 0".into()));

@@ -149,7 +149,7 @@ impl Settings {
     /// default becomes.
     pub fn paper_impacts() -> Self {
         let mut s = Self::default();
-        s.impact.step_control = crate::impact::StepControl::Fixed { impulse_step: 1e-4 };
+        s.impact.step_control = crate::impact::StepControl::paper();
         s
     }
 

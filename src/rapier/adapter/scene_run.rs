@@ -16,7 +16,9 @@ pub fn impact_input_json(sw: &SceneWorld) -> serde_json::Value {
     let settings = sw.topple.settings().impact;
     let (impulse_step, tolerance) = match settings.step_control {
         crate::impact::StepControl::Fixed { impulse_step } => (impulse_step, None),
-        crate::impact::StepControl::Adaptive { tolerance } => (1e-4, Some(tolerance)),
+        // the input format names a tolerance only: the time-domain solver's
+        crate::impact::StepControl::Adaptive { tolerance }
+        | crate::impact::StepControl::AdaptiveImpulse { tolerance } => (1e-4, Some(tolerance)),
     };
     let contacts: Vec<serde_json::Value> = contacts
         .iter()

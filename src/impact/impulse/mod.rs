@@ -1,4 +1,8 @@
-//! The stepping loop of the LZB resolver.
+//! The paper's scheme: the LZB law stepped in the normal impulse of a primary
+//! contact (paper Sec. 2.3 and 3.1), with the fixed step ΔP = 10⁻⁴ P₀ of the
+//! paper ([`crate::impact::StepControl::Fixed`]) or the error-controlled impulse step topple
+//! used before its time-domain solver ([`crate::impact::StepControl::AdaptiveImpulse`], kept
+//! so that benchmarks can show both side by side).
 //!
 //! Data are flat: one [`Row`] of frozen geometry and one [`ContactState`] per
 //! contact, one `[vx, vy, ω]` per body plus a last slot for the fixed world.
@@ -44,9 +48,18 @@
 //! F = k δ^α integrated in time, separations and re-contacts included.
 
 use super::{
-    validate, Body, BodyVelocity, Contact, ContactImpulse, ImpactError, ImpactOutcome,
-    ImpactSettings, StepControl, StopReason,
+    Body, BodyVelocity, Contact, ContactImpulse, ImpactError, ImpactOutcome, ImpactSettings,
+    StopReason,
 };
+
+/// The two ways of stepping the impulse.
+#[derive(Clone, Copy, Debug)]
+pub(crate) enum ImpulseScheme {
+    /// [`crate::impact::StepControl::Fixed`].
+    Fixed { impulse_step: f64 },
+    /// [`crate::impact::StepControl::AdaptiveImpulse`].
+    Adaptive { tolerance: f64 },
+}
 
 /// Frozen geometry and material of one contact.
 #[derive(Clone, Copy, Debug, Default)]
@@ -142,7 +155,7 @@ struct ContactState {
 /// Scales of one impact, fixed at its start.
 #[derive(Clone, Copy, Debug, Default)]
 struct Scales {
-    /// P₀ (N·s), see [`StepControl::Fixed`].
+    /// P₀ (N·s), see [`crate::impact::StepControl::Fixed`].
     impulse: f64,
     /// Largest approach speed at the start (m/s).
     velocity: f64,
@@ -195,39 +208,16 @@ enum Step {
     Advanced { length: f64 },
 }
 
-/// Reusable LZB impact solver.
+/// The impulse-stepping integrator (see the module docs). Keeps its buffers
+/// between impacts; the stepping loop never allocates.
 ///
-/// Keeps its buffers between calls, so resolving many impacts allocates only
-/// when a problem is larger than any before it. The stepping loop itself never
-/// allocates.
-///
-/// P₀, the impulse scale of [`StepControl`], is the larger of the magnitude of
-/// the free bodies' total linear momentum (the paper's definition) and the
-/// largest impulse that would stop one approaching contact on its own
-/// (|δ̇_i| / W_ii); the second matters when the momentum is zero, as for two
-/// bodies meeting head-on.
-///
-/// ```
-/// use topple::impact::{Body, Contact, ContactMaterial, ImpactSettings, ImpactSolver};
-/// let mut solver = ImpactSolver::new();
-/// // Newton's cradle of three balls (m = 1 kg, I irrelevant), e = 1
-/// let bodies = [
-///     Body::new(1.0, 1.0).with_velocity([1.0, 0.0]),
-///     Body::new(1.0, 1.0).with_position([0.2, 0.0]),
-///     Body::new(1.0, 1.0).with_position([0.4, 0.0]),
-/// ];
-/// let hertz = ContactMaterial::hertz(1e9);
-/// let contacts = [
-///     Contact::new([Some(0), Some(1)], [0.1, 0.0], [1.0, 0.0], hertz),
-///     Contact::new([Some(1), Some(2)], [0.3, 0.0], [1.0, 0.0], hertz),
-/// ];
-/// let out = solver.solve(&bodies, &contacts, &ImpactSettings::adaptive(1e-6)).unwrap();
-/// let total: f64 = out.bodies.iter().map(|b| b.velocity[0]).sum();
-/// assert!((total - 1.0).abs() < 1e-9); // momentum
-/// assert!(out.kinetic_energy_after <= out.kinetic_energy_before * (1.0 + 1e-9));
-/// ```
+/// P₀, the impulse scale of [`crate::impact::StepControl::Fixed`], is the larger of the
+/// magnitude of the free bodies' total linear momentum (the paper's
+/// definition) and the largest impulse that would stop one approaching contact
+/// on its own (|δ̇_i| / W_ii); the second matters when the momentum is zero, as
+/// for two bodies meeting head-on.
 #[derive(Debug, Default)]
-pub struct ImpactSolver {
+pub(crate) struct ImpulseStepper {
     rows: Vec<Row>,
     inv_mass: Vec<f64>,
     inv_inertia: Vec<f64>,
@@ -294,37 +284,17 @@ fn cross(r: [f64; 2], v: [f64; 2]) -> f64 {
     r[0] * v[1] - r[1] * v[0]
 }
 
-impl ImpactSolver {
-    /// A solver with empty buffers.
-    pub fn new() -> Self {
-        Self::default()
-    }
-
-    /// Resolves one impact and returns a new [`ImpactOutcome`].
-    pub fn solve(
+impl ImpulseStepper {
+    /// Resolves one validated impact into `out` with a fixed or an adaptive
+    /// impulse step. Errors: the step limit or a non-finite state.
+    pub(crate) fn solve_into(
         &mut self,
         bodies: &[Body],
         contacts: &[Contact],
-        settings: &ImpactSettings,
-    ) -> Result<ImpactOutcome, ImpactError> {
-        let mut out = ImpactOutcome::default();
-        self.solve_into(bodies, contacts, settings, &mut out)?;
-        Ok(out)
-    }
-
-    /// Resolves one impact into `out`, reusing its vectors.
-    ///
-    /// Errors: invalid input (checked before any stepping), the step limit, or
-    /// a non-finite state. Fixed bodies keep their input velocity (they may be
-    /// kinematic); a contact between two fixed bodies takes no part.
-    pub fn solve_into(
-        &mut self,
-        bodies: &[Body],
-        contacts: &[Contact],
+        scheme: ImpulseScheme,
         settings: &ImpactSettings,
         out: &mut ImpactOutcome,
     ) -> Result<(), ImpactError> {
-        validate::check(bodies, contacts, settings)?;
         self.load(bodies, contacts);
         self.elapsed = 0.0;
         self.e0_hold = settings.e0_hold;
@@ -335,14 +305,14 @@ impl ImpactSolver {
         let reason = if self.scales.velocity == 0.0 {
             StopReason::NoApproach
         } else {
-            match settings.step_control {
-                StepControl::Fixed { impulse_step } => {
+            match scheme {
+                ImpulseScheme::Fixed { impulse_step } => {
                     self.adaptive = false;
                     let h = impulse_step * self.scales.impulse;
                     self.landing_impulse = MIN_LANDING * h;
                     self.run_fixed(h, settings.max_steps, out)?
                 }
-                StepControl::Adaptive { tolerance } => {
+                ImpulseScheme::Adaptive { tolerance } => {
                     self.adaptive = true;
                     self.landing_impulse = MIN_LANDING * 1e-4 * self.scales.impulse;
                     self.run_adaptive(tolerance, settings.max_steps, out)?
@@ -1374,7 +1344,7 @@ fn apply_increments(
 ) {
     for (row, &p) in rows.iter().zip(increment) {
         if p > 0.0 {
-            ImpactSolver::apply(row, row.normal_axis(), p, inv_mass, inv_inertia, v);
+            ImpulseStepper::apply(row, row.normal_axis(), p, inv_mass, inv_inertia, v);
         }
     }
 }
@@ -1396,7 +1366,7 @@ fn settle(
         return 0.0;
     }
     *accumulated = wanted;
-    ImpactSolver::apply(row, axis, change, inv_mass, inv_inertia, v);
+    ImpulseStepper::apply(row, axis, change, inv_mass, inv_inertia, v);
     change.abs() * w
 }
 

@@ -1,0 +1,373 @@
+//! Stage 1: the impact's frozen data — bodies, contact rows, friction
+//! patches, scales — and the initial state vector.
+//!
+//! The state vector y holds, in this order: [vx, vy, ω] of every body slot
+//! (the fixed world is the last slot), the compression q of every contact
+//! (negative: an open gap), the normal and tangential impulses P_n, P_t of
+//! every contact (outputs: they feed nothing back, but integrating them with
+//! the same Runge–Kutta weights keeps v − M⁻¹ Jᵀ P exactly constant, so the
+//! impulses reported explain the velocities) and the time since the impact
+//! started (the independent variable is not always the time, see `Clock`).
+
+use super::super::{Body, Contact};
+use super::law::Law;
+use super::{Integrator, PatchMode, PointState};
+
+/// A body slot: inverse mass and inertia (0 for fixed bodies and the world)
+/// and the radius of gyration ρ = √(I/m) that turns ω errors into speeds.
+#[derive(Clone, Copy, Debug, Default)]
+pub(super) struct BodySlot {
+    pub inv_mass: f64,
+    pub inv_inertia: f64,
+    pub gyration: f64,
+}
+
+/// A direction of impulse on a pair of bodies with its moment arms r × dir.
+#[derive(Clone, Copy, Debug, Default)]
+pub(super) struct Axis {
+    pub dir: [f64; 2],
+    pub arm_a: f64,
+    pub arm_b: f64,
+}
+
+impl Axis {
+    /// `self − c · other` (the direction of a held normal force that drags
+    /// sliding friction along).
+    pub fn minus(self, c: f64, other: Axis) -> Axis {
+        Axis {
+            dir: [
+                self.dir[0] - c * other.dir[0],
+                self.dir[1] - c * other.dir[1],
+            ],
+            arm_a: self.arm_a - c * other.arm_a,
+            arm_b: self.arm_b - c * other.arm_b,
+        }
+    }
+}
+
+/// Frozen geometry and law of one contact point.
+#[derive(Clone, Copy, Debug)]
+pub(super) struct Row {
+    /// Body slots; the first body takes −F, the second +F.
+    pub a: usize,
+    pub b: usize,
+    pub normal: Axis,
+    /// The direction F pushes along: the normal, plus −μ s times the
+    /// tangent while the point's patch slides with sign s (kept by
+    /// `Integrator::set_patch`), and the friction factor −μ s itself.
+    pub drive: Axis,
+    pub slide: f64,
+    /// 1/m and 1/I of body a, then of body b (0 for fixed bodies).
+    pub inverse: [f64; 4],
+    pub law: Law,
+    /// Friction patch (see [`Patch`]).
+    pub patch: usize,
+    /// W_nn = J_n M⁻¹ J_nᵀ (1/kg).
+    pub w_nn: f64,
+    /// Compression that would store the energy of an approach at the
+    /// impact's velocity scale (m): the scale of q's error.
+    pub q_scale: f64,
+    /// Compressions within ± this (10⁻¹² q_scale) count as zero (m).
+    pub q_zero: f64,
+    /// A point whose compression stays below this (10⁻⁶ q_scale, m) has not
+    /// loaded: when it separates its (negligible) energy is not booked as
+    /// a compression that ended.
+    pub q_load: f64,
+    /// False when neither body can move: such a contact takes no part.
+    pub movable: bool,
+}
+
+/// Contacts of one body pair whose tangential rows are the same (the points
+/// of one flat face: r × t is the distance of the face's line from each
+/// centre of mass, the same for every point on it). Coulomb's law per point
+/// with one shared slip velocity is exactly Coulomb's law of the patch with
+/// the summed normal force, so stick and slip are decided per patch: its
+/// constraint rows stay independent where the points' would not.
+#[derive(Clone, Copy, Debug)]
+pub(super) struct Patch {
+    pub a: usize,
+    pub b: usize,
+    pub tangent: Axis,
+    /// W_tt (1/kg).
+    pub w_tt: f64,
+    /// Sliding μ and the sticking bound max(μ_s, μ); μ = ∞: no slip.
+    pub friction: f64,
+    pub stick_bound: f64,
+    /// Members: `members[first..first + count]`.
+    pub first: usize,
+    pub count: usize,
+}
+
+impl Patch {
+    pub fn no_slip(&self) -> bool {
+        self.friction == f64::INFINITY
+    }
+
+    pub fn frictionless(&self) -> bool {
+        self.w_tt <= 0.0 || (self.friction == 0.0 && self.stick_bound == 0.0)
+    }
+}
+
+/// Scales of one impact, fixed at its start.
+#[derive(Clone, Copy, Debug, Default)]
+pub(super) struct Scales {
+    /// Largest approach speed at the start (m/s).
+    pub velocity: f64,
+    /// Normal and tangential rates within ± this are taken as zero (m/s):
+    /// rounding left after landing on a switch.
+    pub rate: f64,
+    /// A point that starts to load approaching faster than this (10⁻³ of
+    /// the velocity scale, m/s) starts a segment of its own (its force grows
+    /// as t^α, see `Variable::Root`).
+    pub onset: f64,
+    /// The shortest time scale of the points approaching at the start (s,
+    /// law.rs).
+    pub time: f64,
+}
+
+/// Offsets of the state vector's parts.
+#[derive(Clone, Copy, Debug, Default)]
+pub(super) struct Layout {
+    /// Body slots, the world included.
+    pub bodies: usize,
+    pub contacts: usize,
+}
+
+impl Layout {
+    pub fn q(&self, i: usize) -> usize {
+        3 * self.bodies + i
+    }
+    pub fn pn(&self, i: usize) -> usize {
+        3 * self.bodies + self.contacts + i
+    }
+    pub fn pt(&self, i: usize) -> usize {
+        3 * self.bodies + 2 * self.contacts + i
+    }
+    /// The time (s) since the impact started.
+    pub fn time(&self) -> usize {
+        3 * (self.bodies + self.contacts)
+    }
+    pub fn len(&self) -> usize {
+        3 * (self.bodies + self.contacts) + 1
+    }
+}
+
+#[inline]
+fn cross(r: [f64; 2], v: [f64; 2]) -> f64 {
+    r[0] * v[1] - r[1] * v[0]
+}
+
+/// Same direction, same arms: the tangential rows of two points coincide.
+fn same_axis(x: &Axis, y: &Axis, length: f64) -> bool {
+    let close = |p: f64, q: f64, scale: f64| (p - q).abs() <= 1e-9 * scale;
+    close(x.dir[0], y.dir[0], 1.0)
+        && close(x.dir[1], y.dir[1], 1.0)
+        && close(x.arm_a, y.arm_a, length)
+        && close(x.arm_b, y.arm_b, length)
+}
+
+impl Integrator {
+    /// Builds every frozen datum and the initial state; sizes the buffers.
+    pub(super) fn load(&mut self, bodies: &[Body], contacts: &[Contact]) {
+        let world = bodies.len();
+        self.layout = Layout {
+            bodies: world + 1,
+            contacts: contacts.len(),
+        };
+        self.bodies.clear();
+        self.y.clear();
+        for b in bodies {
+            let slot = if b.fixed {
+                BodySlot::default()
+            } else {
+                BodySlot {
+                    inv_mass: 1.0 / b.mass,
+                    inv_inertia: 1.0 / b.inertia,
+                    gyration: (b.inertia / b.mass).sqrt(),
+                }
+            };
+            self.bodies.push(slot);
+            self.y
+                .extend([b.velocity[0], b.velocity[1], b.angular_velocity]);
+        }
+        self.bodies.push(BodySlot::default());
+        self.y.extend([0.0; 3]);
+
+        // body size, for comparing moment arms
+        let length = self
+            .bodies
+            .iter()
+            .map(|s| s.gyration)
+            .fold(0.0f64, f64::max)
+            .max(f64::MIN_POSITIVE);
+
+        self.rows.clear();
+        self.patches.clear();
+        self.members.clear();
+        let mut tangents = std::mem::take(&mut self.tangents);
+        tangents.clear();
+        for c in contacts {
+            let a = c.bodies[0].unwrap_or(world);
+            let b = c.bodies[1].unwrap_or(world);
+            let len = c.normal[0].hypot(c.normal[1]);
+            let n = [c.normal[0] / len, c.normal[1] / len];
+            let t = [-n[1], n[0]];
+            let arm = |slot: usize| {
+                if slot == world {
+                    [0.0, 0.0]
+                } else {
+                    let p = bodies[slot].position;
+                    [c.point[0] - p[0], c.point[1] - p[1]]
+                }
+            };
+            let (ra, rb) = (arm(a), arm(b));
+            let normal = Axis {
+                dir: n,
+                arm_a: cross(ra, n),
+                arm_b: cross(rb, n),
+            };
+            let tangent = Axis {
+                dir: t,
+                arm_a: cross(ra, t),
+                arm_b: cross(rb, t),
+            };
+            let w_nn = self.w(a, b, &normal, &normal);
+            let m = &c.material;
+            let (sa, sb) = (self.bodies[a], self.bodies[b]);
+            self.rows.push(Row {
+                a,
+                b,
+                normal,
+                drive: normal,
+                slide: 0.0,
+                inverse: [sa.inv_mass, sa.inv_inertia, sb.inv_mass, sb.inv_inertia],
+                law: Law::new(m.stiffness, m.exponent, m.restitution),
+                patch: 0,
+                w_nn,
+                q_scale: 0.0,
+                q_zero: 0.0,
+                q_load: 0.0,
+                movable: w_nn > 0.0,
+            });
+            tangents.push(tangent);
+        }
+        self.group_patches(contacts, &tangents, length);
+        self.tangents = tangents;
+
+        let n = contacts.len();
+        let layout = self.layout;
+        self.y.resize(layout.len(), 0.0);
+        self.points.clear();
+        self.points.resize(
+            n,
+            PointState {
+                switched_at: f64::NAN,
+                ..PointState::default()
+            },
+        );
+        self.patch_modes.clear();
+        self.patch_modes
+            .resize(self.patches.len(), PatchMode::default());
+        self.patch_states.clear();
+        self.patch_states
+            .resize(self.patches.len(), Default::default());
+
+        // Scales: the largest approach speed and the compression scales.
+        let mut speed: f64 = 0.0;
+        for i in 0..n {
+            if self.rows[i].movable {
+                speed = speed.max(-super::rhs::normal_rate(&self.rows[i], &self.y));
+            }
+        }
+        let mut time = f64::INFINITY;
+        for row in &mut self.rows {
+            if row.movable && speed > 0.0 {
+                row.q_scale = row.law.compression(0.5 * speed * speed / row.w_nn);
+                row.q_zero = 1e-12 * row.q_scale;
+                row.q_load = 1e-6 * row.q_scale;
+                let rate = super::rhs::normal_rate(row, &self.y);
+                if rate < 0.0 {
+                    time = time.min(row.law.time_scale(-rate, row.w_nn));
+                }
+            }
+        }
+        self.scales = Scales {
+            velocity: speed,
+            rate: 1e-9 * speed,
+            onset: 1e-3 * speed,
+            time: if time.is_finite() { time } else { 0.0 },
+        };
+        self.generation = 0;
+        self.clock = super::Clock::default();
+    }
+
+    /// W = J_x M⁻¹ J_yᵀ for two axes on the same pair of body slots (1/kg).
+    pub(super) fn w(&self, a: usize, b: usize, x: &Axis, y: &Axis) -> f64 {
+        let (sa, sb) = (&self.bodies[a], &self.bodies[b]);
+        let dot = x.dir[0] * y.dir[0] + x.dir[1] * y.dir[1];
+        (sa.inv_mass + sb.inv_mass) * dot
+            + sa.inv_inertia * x.arm_a * y.arm_a
+            + sb.inv_inertia * x.arm_b * y.arm_b
+    }
+
+    /// Groups the contacts into friction patches (contacts of one body pair
+    /// with the same tangential row and the same coefficients) and lists
+    /// each patch's members contiguously in `members`.
+    fn group_patches(&mut self, contacts: &[Contact], tangents: &[Axis], length: f64) {
+        let n = contacts.len();
+        self.order.clear();
+        self.order.extend(0..n);
+        let rows = &self.rows;
+        self.order.sort_by_key(|&i| (rows[i].a, rows[i].b, i));
+        let mut pair_start = 0; // first patch of the current body pair
+        for k in 0..n {
+            let i = self.order[k];
+            let (a, b) = (self.rows[i].a, self.rows[i].b);
+            if k > 0 {
+                let prev = &self.rows[self.order[k - 1]];
+                if (prev.a, prev.b) != (a, b) {
+                    pair_start = self.patches.len();
+                }
+            }
+            let m = &contacts[i].material;
+            let stick_bound = m.stick_friction.max(m.friction);
+            let found = (pair_start..self.patches.len()).find(|&p| {
+                let patch = &self.patches[p];
+                patch.friction == m.friction
+                    && patch.stick_bound == stick_bound
+                    && same_axis(&patch.tangent, &tangents[i], length)
+            });
+            self.rows[i].patch = found.unwrap_or_else(|| {
+                let tangent = tangents[i];
+                self.patches.push(Patch {
+                    a,
+                    b,
+                    tangent,
+                    w_tt: self.w(a, b, &tangent, &tangent),
+                    friction: m.friction,
+                    stick_bound,
+                    first: 0,
+                    count: 0,
+                });
+                self.patches.len() - 1
+            });
+        }
+        // members, patch by patch (a counting sort)
+        for i in 0..n {
+            self.patches[self.rows[i].patch].count += 1;
+        }
+        let mut next = 0;
+        for patch in &mut self.patches {
+            patch.first = next;
+            next += patch.count;
+            patch.count = 0;
+        }
+        self.members.clear();
+        self.members.resize(n, 0);
+        for i in 0..n {
+            let patch = &mut self.patches[self.rows[i].patch];
+            self.members[patch.first + patch.count] = i;
+            patch.count += 1;
+        }
+    }
+}

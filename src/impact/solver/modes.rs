@@ -1,0 +1,254 @@
+//! Stage 6: the modes at an instant — which touching points are pushed
+//! together, which patches stick or slide, which held points let go — at
+//! the start of the impact and after every switch.
+//!
+//! * A touching point (q = 0) that does not separate (δ̇ ≤ 0, to rounding)
+//!   is closed: it loads as soon as it is pushed in. An e = 0 point that has
+//!   just lost its energy after a fast load cycle
+//!   ([`crate::impact::ImpactSettings::fast_cycle`], or every cycle with
+//!   [`crate::impact::ImpactSettings::e0_hold`]) is held instead when the
+//!   other forces push it in (δ̈ < 0).
+//! * A held point lets go when its force λ would be negative, or is zero
+//!   (nothing pushes it any more).
+//! * A patch with no loaded point has no friction (idle). A loaded patch
+//!   without slip sticks while the force that keeps it stuck is within
+//!   μ_s N; otherwise it slides against the push. A sliding patch whose slip
+//!   is zero keeps sliding only if the push accelerates it that way.
+//! * A patch without slip (μ = ∞, docs/model.md §4) sticks whenever it is
+//!   loaded; if it was slipping, the tangential impulse that stops its slip
+//!   (with every other row held) is applied at once: the limit μ → ∞ of
+//!   the sliding law. A patch that sticks after its slip stopped takes the
+//!   same (rounding-sized) impulse, so that it sticks at zero slip exactly.
+//!
+//! Each change is followed by a new evaluation, until nothing changes (at
+//! most a few passes; a cap ends a cycle, which the next event resolves).
+
+use super::constraints::Target;
+use super::rhs::{normal_rate, rate};
+use super::{Integrator, PatchMode, PointMode};
+
+impl Integrator {
+    /// Settles every mode at the present state.
+    pub(super) fn settle(&mut self) {
+        let cap = 4 + 2 * (self.rows.len() + self.patches.len());
+        let mut slope = std::mem::take(&mut self.probe_slope);
+        for _ in 0..cap {
+            self.refresh_constraints();
+            let y = std::mem::take(&mut self.y);
+            self.eval(&y, &mut slope, false);
+            self.y = y;
+            let mut changed = self.settle_points(&slope);
+            changed |= self.settle_patches(&slope);
+            if !changed {
+                break;
+            }
+        }
+        self.refresh_constraints();
+        self.probe_slope = slope;
+    }
+
+    fn settle_points(&mut self, slope: &[f64]) -> bool {
+        let thr = self.scales.rate;
+        let lay = self.layout;
+        let now = self.y[lay.time()];
+        let mut changed = false;
+        for i in 0..lay.contacts {
+            let row = &self.rows[i];
+            if !row.movable {
+                continue;
+            }
+            let point = &mut self.points[i];
+            match point.mode {
+                PointMode::Compress if point.released => {
+                    // an e = 0 point whose fast load cycle just ended: held
+                    // if it is pushed in again
+                    let rate = normal_rate(row, &self.y);
+                    if rate <= 2.0 * thr && normal_rate(row, slope) < 0.0 {
+                        point.mode = PointMode::Held;
+                        point.switched_at = now;
+                        self.constraints_dirty = true;
+                        changed = true;
+                    }
+                    point.released = false;
+                }
+                PointMode::Held if point.held_force <= 0.0 => {
+                    point.mode = PointMode::Compress;
+                    point.switched_at = now;
+                    self.y[lay.q(i)] = 0.0;
+                    self.constraints_dirty = true;
+                    changed = true;
+                }
+                _ => {}
+            }
+        }
+        changed
+    }
+
+    /// Whether a point carries load or is about to: compressed, held, or
+    /// touching and approaching.
+    pub(super) fn carries_load(&self, i: usize) -> bool {
+        let row = &self.rows[i];
+        let q = self.y[self.layout.q(i)];
+        match self.points[i].mode {
+            PointMode::Held | PointMode::Expand => true,
+            PointMode::Compress => {
+                q > row.q_zero
+                    || (q >= -row.q_zero && normal_rate(row, &self.y) < -self.scales.rate)
+            }
+        }
+    }
+
+    fn settle_patches(&mut self, slope: &[f64]) -> bool {
+        let thr = self.scales.rate;
+        let mut changed = false;
+        let mut jump = false;
+        for p in 0..self.patches.len() {
+            let patch = &self.patches[p];
+            let members = &self.members[patch.first..patch.first + patch.count];
+            let slip = rate(&self.y, patch.a, patch.b, &patch.tangent);
+            let now = self.patch_modes[p];
+            let next = if patch.frictionless() {
+                PatchMode::Idle
+            } else if patch.no_slip() {
+                // sticks while it carries load, has no friction otherwise
+                if members.iter().any(|&i| self.carries_load(i)) {
+                    PatchMode::Stick
+                } else {
+                    PatchMode::Idle
+                }
+            } else {
+                match now {
+                    PatchMode::Stick => {
+                        let load = &self.patch_states[p];
+                        if load.friction.abs() > patch.stick_bound * load.normal {
+                            PatchMode::Slide(-load.friction.signum())
+                        } else {
+                            PatchMode::Stick
+                        }
+                    }
+                    PatchMode::Slide(s) if s * slip > thr => now,
+                    PatchMode::Slide(s) if slip.abs() <= thr => {
+                        // at zero slip: keeps sliding only if pushed that way
+                        if s * rate(slope, patch.a, patch.b, &patch.tangent) > 0.0 {
+                            now
+                        } else {
+                            PatchMode::Stick
+                        }
+                    }
+                    _ if slip.abs() <= thr => PatchMode::Stick,
+                    _ => PatchMode::Slide(slip.signum()),
+                }
+            };
+            // a stuck patch's slip (rounding left by the switch that stuck
+            // it, or any slip of a patch without slip) stops at once
+            jump |= next == PatchMode::Stick && slip.abs() > 1e-3 * thr;
+            if next != now {
+                self.set_patch(p, next);
+                changed = true;
+            }
+        }
+        if jump {
+            self.stop_slips();
+        }
+        changed
+    }
+
+    /// Changes a patch's mode; the constraint rows follow.
+    pub(super) fn set_patch(&mut self, p: usize, mode: PatchMode) {
+        self.patch_modes[p] = mode;
+        self.patch_states[p].switched_at = self.y[self.layout.time()];
+        let patch = &self.patches[p];
+        let slide = match mode {
+            PatchMode::Slide(s) => -patch.friction * s,
+            PatchMode::Idle | PatchMode::Stick => 0.0,
+        };
+        for &i in &self.members[patch.first..patch.first + patch.count] {
+            let row = &mut self.rows[i];
+            row.slide = slide;
+            row.drive = row.normal.minus(-slide, patch.tangent);
+        }
+        self.constraints_dirty = true;
+    }
+
+    /// Rebuilds and factors the constraint rows if a mode changed.
+    fn refresh_constraints(&mut self) {
+        if !self.constraints_dirty {
+            return;
+        }
+        self.constraints_dirty = false;
+        self.constraints.clear();
+        for (p, patch) in self.patches.iter().enumerate() {
+            if self.patch_modes[p] == PatchMode::Stick {
+                self.constraints.add(
+                    Target::Stick(p),
+                    patch.a,
+                    patch.b,
+                    patch.tangent,
+                    patch.tangent,
+                );
+            }
+        }
+        for (i, row) in self.rows.iter().enumerate() {
+            if self.points[i].mode != PointMode::Held {
+                continue;
+            }
+            let patch = &self.patches[row.patch];
+            let push = match self.patch_modes[row.patch] {
+                PatchMode::Slide(s) => row.normal.minus(patch.friction * s, patch.tangent),
+                _ => row.normal,
+            };
+            self.constraints
+                .add(Target::Held(i), row.a, row.b, row.normal, push);
+        }
+        self.constraints.factor(&self.bodies);
+    }
+
+    /// The impulse that stops the slip of every stuck row at once (and
+    /// keeps every held row's rate at zero), applied to the velocities and
+    /// booked on the rows' points.
+    fn stop_slips(&mut self) {
+        self.refresh_constraints();
+        let lay = self.layout;
+        let mut y = std::mem::take(&mut self.y);
+        self.constraints
+            .project(&self.bodies, &mut y[..3 * lay.bodies]);
+        self.y = y;
+        for k in 0..self.constraints.len() {
+            match self.constraints.force(k) {
+                (Target::Held(i), p) => {
+                    // a held row of a sliding patch pushes along
+                    // n − μ s t: its friction impulse is booked with it
+                    self.y[lay.pn(i)] += p;
+                    self.y[lay.pt(i)] += self.rows[i].slide * p;
+                }
+                (Target::Stick(patch), p) => {
+                    let patch = &self.patches[patch];
+                    let members = &self.members[patch.first..patch.first + patch.count];
+                    // booked on the points that carry load (all of them if
+                    // none does yet)
+                    let loaded = members.iter().filter(|&&i| self.carries_load(i)).count();
+                    for &i in members {
+                        let share = if loaded == 0 {
+                            p / members.len() as f64
+                        } else if self.carries_load(i) {
+                            p / loaded as f64
+                        } else {
+                            0.0
+                        };
+                        self.y[lay.pt(i)] += share;
+                    }
+                }
+            }
+        }
+    }
+
+    /// Records the largest compression each loaded point has reached.
+    pub(super) fn note_peaks(&mut self) {
+        let lay = self.layout;
+        for (i, point) in self.points.iter_mut().enumerate() {
+            if matches!(point.mode, PointMode::Compress | PointMode::Expand) {
+                point.peak = point.peak.max(self.y[lay.q(i)]);
+            }
+        }
+    }
+}

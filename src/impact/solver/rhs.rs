@@ -1,0 +1,216 @@
+//! Stage 2: the right-hand side dy/dt of the impact's equations of motion.
+//!
+//! M dv/dt = Σ J_nᵀ F + Σ J_tᵀ F_t (paper Eq. 21 divided by dt), with
+//!
+//! * F = k q^α at every loaded point (compression or expansion);
+//! * sliding friction F_t = −μ s (F + λ) at every point of a sliding patch
+//!   (s the sign of its slip, fixed between events; paper Eq. 20 in
+//!   differential form, docs/model.md §4);
+//! * the forces of the constraint rows — stuck patches (no slip) and held
+//!   points (no approach) — solved so that their rates stay constant
+//!   (constraints.rs);
+//!
+//! and dq/dt from the contact law (law.rs), dP_n/dt = F + λ and dP_t/dt the
+//! friction force of each point (a stuck patch's force is shared among its
+//! points in proportion to their normal forces, so that each point satisfies
+//! Coulomb's bound when the patch does).
+//!
+//! Every mode (open, compression, expansion, held, stick, slide) is fixed
+//! between events, so the right-hand side is smooth within a step; the probe
+//! notes every trial point where a mode's own condition fails, and the
+//! event stage (events.rs) locates the switch on the step's interpolant.
+
+use super::load::{Axis, BodySlot, Row};
+use super::{Integrator, PatchMode, PointMode};
+
+/// Adds force `f` along `axis` (−f on body `a`, +f on body `b`) to the
+/// accelerations `acc` ([ax, ay, α] per body slot).
+#[inline]
+pub(super) fn push(bodies: &[BodySlot], a: usize, b: usize, axis: &Axis, f: f64, acc: &mut [f64]) {
+    let (sa, sb) = (&bodies[a], &bodies[b]);
+    let inverse = [sa.inv_mass, sa.inv_inertia, sb.inv_mass, sb.inv_inertia];
+    push_with(inverse, a, b, axis, f, acc);
+}
+
+/// [`push`] with the bodies' inverse masses and inertias given.
+#[inline]
+fn push_with(inverse: [f64; 4], a: usize, b: usize, axis: &Axis, f: f64, acc: &mut [f64]) {
+    let [ma, ia, mb, ib] = inverse;
+    let pa = &mut acc[3 * a..3 * a + 3];
+    pa[0] -= ma * f * axis.dir[0];
+    pa[1] -= ma * f * axis.dir[1];
+    pa[2] -= ia * f * axis.arm_a;
+    let pb = &mut acc[3 * b..3 * b + 3];
+    pb[0] += mb * f * axis.dir[0];
+    pb[1] += mb * f * axis.dir[1];
+    pb[2] += ib * f * axis.arm_b;
+}
+
+/// Relative rate along `axis` of body `b` against body `a` in the velocities
+/// (or accelerations) `v`: dir·(v_b − v_a) + ω_b arm_b − ω_a arm_a.
+#[inline]
+pub(super) fn rate(v: &[f64], a: usize, b: usize, axis: &Axis) -> f64 {
+    let va = &v[3 * a..3 * a + 3];
+    let vb = &v[3 * b..3 * b + 3];
+    axis.dir[0] * (vb[0] - va[0]) + axis.dir[1] * (vb[1] - va[1]) + vb[2] * axis.arm_b
+        - va[2] * axis.arm_a
+}
+
+/// Normal rate δ̇ of a row (m/s).
+#[inline]
+pub(super) fn normal_rate(row: &Row, v: &[f64]) -> f64 {
+    rate(v, row.a, row.b, &row.normal)
+}
+
+impl Integrator {
+    /// Whether point `i` starting to load must be a switch whatever its
+    /// rate: its patch has no slip and no load yet (it sticks from then on).
+    #[inline]
+    pub(super) fn onset_matters(&self, i: usize) -> bool {
+        let p = self.rows[i].patch;
+        self.patches[p].no_slip() && self.patch_modes[p] == PatchMode::Idle
+    }
+
+    /// dy/dt at state `y` into `dy`. With `probe`, notes the points and
+    /// patches whose mode's condition fails at `y` (see events.rs).
+    pub(super) fn eval(&mut self, y: &[f64], dy: &mut [f64], probe: bool) {
+        let lay = self.layout;
+        let (acc, rest) = dy.split_at_mut(3 * lay.bodies);
+        acc.fill(0.0);
+        // 1. normal forces, with the friction of sliding patches
+        for (i, (row, point)) in self.rows.iter().zip(self.points.iter_mut()).enumerate() {
+            point.held_force = 0.0;
+            let q = y[lay.q(i)];
+            let f = match point.mode {
+                PointMode::Compress if q > 0.0 => row.law.force(q),
+                PointMode::Expand => row.law.force(q),
+                _ => 0.0,
+            };
+            point.force = f;
+            if f != 0.0 {
+                push_with(row.inverse, row.a, row.b, &row.drive, f, acc);
+            }
+        }
+        // 2. constraint forces
+        if !self.constraints.is_empty() {
+            self.constraints.solve(&self.bodies, acc);
+            self.constraint_forces();
+            self.stuck_loads();
+        }
+        // 3. compressions and impulses
+        let n = lay.contacts;
+        let (dq, rest) = rest.split_at_mut(n);
+        let (dpn, rest) = rest.split_at_mut(n);
+        let (dpt, time) = rest.split_at_mut(n);
+        time[0] = 1.0;
+        for i in 0..n {
+            let row = &self.rows[i];
+            let point = &self.points[i];
+            let rate = normal_rate(row, y);
+            let normal = point.force + point.held_force;
+            dq[i] = match point.mode {
+                PointMode::Held => 0.0,
+                PointMode::Expand => row.law.compression_rate(rate, true),
+                PointMode::Compress => -rate,
+            };
+            dpn[i] = normal;
+            dpt[i] = if self.patch_modes[row.patch] == PatchMode::Stick {
+                // shared in proportion to the load, or equally while the
+                // patch carries none (its rows are identical, so any share
+                // books the force the bodies received)
+                let load = &self.patch_states[row.patch];
+                if load.normal > 0.0 {
+                    load.friction * normal / load.normal
+                } else {
+                    load.friction / self.patches[row.patch].count as f64
+                }
+            } else {
+                row.slide * normal
+            };
+            if probe {
+                self.probe_point(i, y[lay.q(i)], rate);
+            }
+        }
+        if probe {
+            self.probe_patches(y);
+        }
+    }
+
+    /// The solved constraint forces: λ of held points, the friction of
+    /// stuck patches.
+    fn constraint_forces(&mut self) {
+        for k in 0..self.constraints.len() {
+            let (target, force) = self.constraints.force(k);
+            match target {
+                super::constraints::Target::Held(i) => self.points[i].held_force = force,
+                super::constraints::Target::Stick(p) => self.patch_states[p].friction = force,
+            }
+        }
+    }
+
+    /// The normal load N = Σ (F + λ) of each stuck patch (N); only stuck
+    /// patches need it (their friction is shared in proportion, and bounded
+    /// by μ_s N).
+    fn stuck_loads(&mut self) {
+        for (p, patch) in self.patches.iter().enumerate() {
+            if self.patch_modes[p] == PatchMode::Stick {
+                let members = &self.members[patch.first..patch.first + patch.count];
+                self.patch_states[p].normal = members
+                    .iter()
+                    .map(|&i| self.points[i].force + self.points[i].held_force)
+                    .sum();
+            }
+        }
+    }
+
+    /// Notes a point whose mode's condition fails at a trial point (see
+    /// events.rs).
+    #[inline]
+    fn probe_point(&mut self, i: usize, q: f64, rate: f64) {
+        let thr = self.scales.rate;
+        let point = &self.points[i];
+        let row = &self.rows[i];
+        let fails = match point.mode {
+            PointMode::Compress => {
+                (rate > thr && q > row.q_load)
+                    || (point.open
+                        && q > 0.0
+                        && (rate < -self.scales.onset || self.onset_matters(i)))
+            }
+            PointMode::Expand => rate < -thr || q < -row.q_zero,
+            PointMode::Held => point.held_force < 0.0,
+        };
+        if fails {
+            self.suspect_point(i);
+        }
+    }
+
+    /// Whether any point of patch `p` carries force at the last evaluation.
+    fn patch_loaded(&self, p: usize) -> bool {
+        let patch = &self.patches[p];
+        self.members[patch.first..patch.first + patch.count]
+            .iter()
+            .any(|&i| self.points[i].force != 0.0 || self.points[i].held_force != 0.0)
+    }
+
+    /// Notes the patches whose mode's condition fails at a trial point.
+    fn probe_patches(&mut self, y: &[f64]) {
+        let thr = self.scales.rate;
+        for p in 0..self.patches.len() {
+            let patch = &self.patches[p];
+            let fails = match self.patch_modes[p] {
+                PatchMode::Idle => false,
+                PatchMode::Slide(s) => {
+                    self.patch_loaded(p) && s * rate(y, patch.a, patch.b, &patch.tangent) < -thr
+                }
+                PatchMode::Stick => {
+                    let load = &self.patch_states[p];
+                    !patch.no_slip() && load.friction.abs() > patch.stick_bound * load.normal
+                }
+            };
+            if fails {
+                self.suspect_patch(p);
+            }
+        }
+    }
+}
