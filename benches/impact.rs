@@ -42,7 +42,7 @@ use std::time::Instant;
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use topple::impact::capture::CapturedImpact;
-use topple::impact::{Body, Contact, ContactMaterial, ImpactSettings, ImpactSolver};
+use topple::impact::{Body, BodyVelocity, Contact, ContactMaterial, ImpactSettings, ImpactSolver};
 
 /// One impact and its converged answer ([vx, vy, ω] per body).
 struct Impact {
@@ -59,7 +59,7 @@ struct Class {
     check: f64,
 }
 
-fn velocities(bodies: &[Body]) -> Vec<[f64; 3]> {
+fn velocities(bodies: &[BodyVelocity]) -> Vec<[f64; 3]> {
     bodies
         .iter()
         .map(|b| [b.velocity[0], b.velocity[1], b.angular_velocity])

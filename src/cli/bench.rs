@@ -6,11 +6,11 @@
 //!
 //! | run | meaning |
 //! | --- | --- |
-//! | `reference:paper` | reference engine, the paper's improved Euler at 10⁻⁴ s, impacts by the time-domain resolver at its default tolerance (10⁻⁴) |
+//! | `reference:paper` | reference engine, the paper's improved Euler at 10⁻⁴ s, impacts at the default adaptive impulse stepping (10⁻⁴) |
 //! | `reference:paper:DT` | the same at time step DT (s) |
 //! | `reference:TOL` | reference engine, adaptive Dormand–Prince at tolerance TOL |
-//! | `reference:…:imp:TOL` | either of the above with the time-domain resolver at TOL |
-//! | `reference:…:imp:impulse-TOL` | either of the above with adaptive impulse stepping at TOL (the previous default) |
+//! | `reference:…:imp:TOL` | either of the above with adaptive impulse stepping at TOL |
+//! | `reference:…:imp:time-TOL` | either of the above with the time-domain resolver at TOL (docs/model.md §7) |
 //! | `reference:…:imp:fixed` | either of the above with the paper's fixed impulse step ΔP = 10⁻⁴ P₀ |
 //! | `rapier:DT` | Rapier with topple at its default settings, time step DT (s) |
 //! | `rapier:DT:STEP` | Rapier with topple, time step DT (s), fixed impulse step ΔP/P₀ = STEP |
@@ -130,12 +130,12 @@ fn parse_run(run: &str, default: Precision) -> anyhow::Result<RunKind> {
             let smooth = format!("reference:{}", head.join(":"));
             let control = if *stepping == "fixed" {
                 StepControl::paper()
-            } else if let Some(tol) = stepping.strip_prefix("impulse-") {
-                StepControl::AdaptiveImpulse {
+            } else if let Some(tol) = stepping.strip_prefix("time-") {
+                StepControl::Adaptive {
                     tolerance: number(tol, "impact tolerance", run)?,
                 }
             } else {
-                StepControl::Adaptive {
+                StepControl::AdaptiveImpulse {
                     tolerance: number(stepping, "impact tolerance", run)?,
                 }
             };
@@ -402,10 +402,8 @@ pub fn run(args: Args) -> anyhow::Result<()> {
 fn family(kind: &RunKind) -> &'static str {
     match kind {
         RunKind::Reference(_, Some(StepControl::Fixed { .. })) => "reference, fixed impulse step",
-        RunKind::Reference(_, Some(StepControl::AdaptiveImpulse { .. })) => {
-            "reference, adaptive impulse step"
-        }
-        RunKind::Reference(..) => "reference, impacts in time",
+        RunKind::Reference(_, Some(StepControl::Adaptive { .. })) => "reference, impacts in time",
+        RunKind::Reference(..) => "reference, adaptive impulse step",
         RunKind::Rapier { .. } => "Rapier + topple",
         RunKind::Native { .. } => "native Rapier",
     }
@@ -584,14 +582,14 @@ mod tests {
             parse_run("reference:paper:imp:1e-4", Precision::F64).unwrap(),
             RunKind::Reference(
                 Integrator::Paper { dt: 1e-4 },
-                Some(StepControl::Adaptive { tolerance: 1e-4 })
+                Some(StepControl::AdaptiveImpulse { tolerance: 1e-4 })
             )
         );
         assert_eq!(
             parse_run("reference:1e-6:imp:1e-5", Precision::F64).unwrap(),
             RunKind::Reference(
                 Integrator::Adaptive { tolerance: 1e-6 },
-                Some(StepControl::Adaptive { tolerance: 1e-5 })
+                Some(StepControl::AdaptiveImpulse { tolerance: 1e-5 })
             )
         );
         assert_eq!(

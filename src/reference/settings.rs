@@ -117,7 +117,7 @@ impl Default for Settings {
             integrator: Integrator::default(),
             impact: ImpactSettings {
                 max_steps: 200_000,
-                ..ImpactSettings::adaptive(Self::IMPACT_TOLERANCE)
+                ..ImpactSettings::adaptive_impulse(Self::IMPACT_TOLERANCE)
             },
             gap_tolerance: 1e-6,
             velocity_tolerance: 1e-3,
@@ -138,7 +138,7 @@ impl Default for Settings {
 
 impl Settings {
     /// The default tolerance of the adaptive impulse stepping (relative to
-    /// the approach speed, see [`crate::impact::StepControl::Adaptive`]).
+    /// the approach speed, see [`crate::impact::StepControl::AdaptiveImpulse`]).
     pub const IMPACT_TOLERANCE: f64 = 1e-4;
     /// The default freeze tolerance (see [`Settings::freeze_tolerance`]).
     pub const FREEZE_TOLERANCE: f64 = 1e-2;
