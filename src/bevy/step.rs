@@ -194,6 +194,7 @@ pub(crate) fn step_contexts(
         }
         let after = world.adapter.stats();
         add_frame(&mut frame, &before, &after);
+        warn_left(&mut world, &colliders);
         if let Ok(mut events) = collector.events.lock() {
             messages.collisions.write_batch(events.drain(..));
         }
@@ -224,6 +225,9 @@ fn add_frame(frame: &mut ToppleFrameStats, before: &ToppleStats, after: &ToppleS
     frame.fallbacks += fallbacks(after) - fallbacks(before);
     frame.rapier_steps += after.rapier_steps - before.rapier_steps;
     frame.topple_seconds += after.topple_seconds - before.topple_seconds;
+    frame.work += after.work - before.work;
+    frame.budget_spent += after.budget_spent - before.budget_spent;
+    frame.native_impacts += after.native_impacts - before.native_impacts;
     let t = &mut frame.totals;
     t.pairs_queried += after.pairs_queried;
     t.contact_points += after.contact_points;
@@ -235,6 +239,30 @@ fn add_frame(frame: &mut ToppleFrameStats, before: &ToppleStats, after: &ToppleS
     t.split_steps += after.split_steps;
     t.rapier_steps += after.rapier_steps;
     t.topple_seconds += after.topple_seconds;
+    t.work += after.work;
+    t.budget_spent += after.budget_spent;
+    t.native_impacts += after.native_impacts;
+}
+
+/// One warning per collider topple leaves to Rapier, naming its entity,
+/// shape and why.
+fn warn_left(world: &mut ToppleWorld, colliders: &RapierContextColliders) {
+    for n in world.adapter.take_notices() {
+        let entity = colliders
+            .colliders
+            .get(n.collider)
+            .map(|co| Entity::from_bits(co.user_data as u64));
+        match entity {
+            Some(e) => warn!(
+                "topple: the {} collider of entity {e} gets Rapier's impacts, not topple's: {}",
+                n.shape, n.reason
+            ),
+            None => warn!(
+                "topple: a {} collider gets Rapier's impacts, not topple's: {}",
+                n.shape, n.reason
+            ),
+        }
+    }
 }
 
 /// Gives every new Rapier context a [`PhysicsClock`], and the default one a
