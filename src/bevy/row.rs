@@ -230,9 +230,9 @@ pub struct DominoRowState {
     pub blocks: Vec<Entity>,
     /// The ground under them.
     pub ground: Entity,
-    hits: HitTracker,
+    pub(crate) hits: HitTracker,
     /// Simulated time of the context when the row's first step began (s).
-    start: Option<f64>,
+    pub(crate) start: Option<f64>,
 }
 
 impl DominoRowState {
