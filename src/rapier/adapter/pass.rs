@@ -330,7 +330,11 @@ impl ImpactPass {
             let origin = vector(path.com1) - rotation.transform_vector(local_com);
             rb.set_position(Pose::new(origin, angle), true);
             rb.set_linvel(vector(path.velocity), true);
-            rb.set_angvel(path.angular_velocity as Real, true);
+            // a body that cannot turn keeps its angular velocity (the
+            // resolver's LOCKED_INERTIA leaves it a change below 10⁻¹²)
+            if rb.mass_properties().effective_world_inv_inertia > 0.0 {
+                rb.set_angvel(path.angular_velocity as Real, true);
+            }
         }
     }
 
