@@ -15,7 +15,7 @@ use super::backend::parry::bounding_volume::BoundingVolume;
 use super::backend::parry::query::{
     ContactManifold, DefaultQueryDispatcher, PersistentQueryDispatcher,
 };
-use super::backend::parry::shape::Shape;
+use super::backend::parry::shape::{Shape, ShapeType};
 use super::backend::prelude::{
     BroadPhaseBvh, Collider, ColliderHandle, ColliderSet, NarrowPhase, QueryFilter, RigidBody,
     RigidBodyHandle, RigidBodySet,
@@ -119,6 +119,8 @@ pub(crate) struct ImpactPass {
     /// The manifolds of the pair being queried: one for two convex shapes,
     /// one per pair of sub-shapes for a composite shape.
     manifolds: Vec<ContactManifold<(), ()>>,
+    /// The same pair queried the other way round (see `manifolds_of`).
+    spare: Vec<ContactManifold<(), ()>>,
     points: Vec<ManifoldPoint>,
     found: Vec<(ColliderHandle, bool)>,
     /// Pairs queried for the group being built.
@@ -480,34 +482,55 @@ impl ImpactPass {
         sb: &dyn Shape,
         reach: Real,
     ) -> usize {
-        let pos12 = pa.inv_mul(pb);
         match geometry {
             Geometry::Convex => {
+                // parry's GJK misses a segment touching a box flat at gaps
+                // near 10⁻⁹ when the segment is the first shape (normal along
+                // the segment, no points): the segment goes second, and the
+                // manifold is flipped back.
+                let swap = segment_like(sa) && !segment_like(sb);
+                let (pos12, s1, s2) = if swap {
+                    (pb.inv_mul(pa), sb, sa)
+                } else {
+                    (pa.inv_mul(pb), sa, sb)
+                };
                 if self.manifolds.is_empty() {
                     self.manifolds.push(ContactManifold::new());
                 }
                 let m = &mut self.manifolds[0];
                 m.clear();
                 let ok = DefaultQueryDispatcher
-                    .contact_manifold_convex_convex(&pos12, sa, sb, None, None, reach, m);
+                    .contact_manifold_convex_convex(&pos12, s1, s2, None, None, reach, m);
+                if swap {
+                    flip_manifold(m);
+                }
                 usize::from(ok.is_ok())
             }
             Geometry::Composite => {
-                self.manifolds.clear();
-                let mut workspace = None;
-                let ok = DefaultQueryDispatcher.contact_manifolds(
-                    &pos12,
-                    sa,
-                    sb,
-                    reach,
-                    &mut self.manifolds,
-                    &mut workspace,
-                );
-                if ok.is_ok() {
-                    self.manifolds.len()
-                } else {
-                    0
+                let count = composite_manifolds(&pa.inv_mul(pb), sa, sb, reach, &mut self.manifolds);
+                // The same GJK miss for a sub-shape, in either order: when
+                // some sub-shapes touch and others have no points, the pair
+                // is queried again the other way round and each empty
+                // manifold takes the other query's points.
+                let partial = |ms: &[ContactManifold<(), ()>]| {
+                    ms.iter().any(|m| m.points.is_empty()) && ms.iter().any(|m| !m.points.is_empty())
+                };
+                if partial(&self.manifolds[..count]) {
+                    let other = composite_manifolds(&pb.inv_mul(pa), sb, sa, reach, &mut self.spare);
+                    for m in &mut self.spare[..other] {
+                        flip_manifold(m);
+                        if m.points.is_empty() {
+                            continue;
+                        }
+                        let same = self.manifolds[..count]
+                            .iter_mut()
+                            .find(|k| k.subshape1 == m.subshape1 && k.subshape2 == m.subshape2);
+                        if let Some(k) = same.filter(|k| k.points.is_empty()) {
+                            std::mem::swap(k, m);
+                        }
+                    }
                 }
+                count
             }
         }
     }
@@ -952,6 +975,43 @@ fn body_pose(rb: &RigidBody, com: [f64; 2], angle: f64) -> Pose {
 
 /// The closed tolerance of this build (m): the settings' tolerance, but not
 /// below what the build resolves (64 ε of the scalar type, per metre).
+/// The manifolds of a pair with a composite shape (one per pair of
+/// sub-shapes) into `out`; how many.
+fn composite_manifolds(
+    pos12: &Pose,
+    sa: &dyn Shape,
+    sb: &dyn Shape,
+    reach: Real,
+    out: &mut Vec<ContactManifold<(), ()>>,
+) -> usize {
+    out.clear();
+    let mut workspace = None;
+    let ok = DefaultQueryDispatcher.contact_manifolds(pos12, sa, sb, reach, out, &mut workspace);
+    if ok.is_ok() {
+        out.len()
+    } else {
+        0
+    }
+}
+
+/// A segment or a polyline (made of segments).
+fn segment_like(s: &dyn Shape) -> bool {
+    matches!(s.shape_type(), ShapeType::Segment | ShapeType::Polyline)
+}
+
+/// A contact manifold of shapes 1 and 2 as the manifold of 2 and 1.
+fn flip_manifold(m: &mut ContactManifold<(), ()>) {
+    std::mem::swap(&mut m.local_n1, &mut m.local_n2);
+    std::mem::swap(&mut m.subshape1, &mut m.subshape2);
+    let (pos1, pos2) = (m.subshape_pos1().copied(), m.subshape_pos2().copied());
+    m.set_subshape_pos1(pos2);
+    m.set_subshape_pos2(pos1);
+    for p in m.points.iter_mut() {
+        std::mem::swap(&mut p.local_p1, &mut p.local_p2);
+        std::mem::swap(&mut p.fid1, &mut p.fid2);
+    }
+}
+
 fn closed_tolerance(s: &ToppleSettings) -> f64 {
     s.patch
         .closed_tolerance
