@@ -43,7 +43,10 @@ fn grounds() -> Vec<(&'static str, ColliderBuilder)> {
             "cuboid",
             ColliderBuilder::cuboid(5.0, 0.5).translation(v(0.0, -0.5)),
         ),
-        ("segment", ColliderBuilder::segment(v(-5.0, 0.0), v(5.0, 0.0))),
+        (
+            "segment",
+            ColliderBuilder::segment(v(-5.0, 0.0), v(5.0, 0.0)),
+        ),
         (
             "polyline",
             ColliderBuilder::polyline(vec![v(-5.0, 0.0), v(0.0, 0.0), v(5.0, 0.0)], None),
@@ -60,7 +63,10 @@ fn grounds() -> Vec<(&'static str, ColliderBuilder)> {
             )
             .expect("a valid mesh"),
         ),
-        ("half-space", ColliderBuilder::halfspace(topple::rapier2d_f64::na::Unit::new_unchecked(Vector::Y))),
+        (
+            "half-space",
+            ColliderBuilder::halfspace(topple::rapier2d_f64::na::Unit::new_unchecked(Vector::Y)),
+        ),
     ]
 }
 
@@ -77,7 +83,10 @@ fn bodies() -> Vec<(&'static str, ColliderBuilder)> {
             ColliderBuilder::convex_hull(&[v(-0.3, -0.1), v(0.3, -0.1), v(0.2, 0.1), v(-0.2, 0.1)])
                 .expect("convex"),
         ),
-        ("round cuboid", ColliderBuilder::round_cuboid(0.18, 0.08, 0.02)),
+        (
+            "round cuboid",
+            ColliderBuilder::round_cuboid(0.18, 0.08, 0.02),
+        ),
         (
             "compound",
             ColliderBuilder::compound(vec![
@@ -221,8 +230,14 @@ fn a_flat_face_across_a_ground_vertex_is_safe() {
 
 #[test]
 fn shapes_topple_cannot_read_are_left_to_rapier_with_one_notice() {
-    let voxels = ColliderBuilder::voxels(Vector::new(0.1, 0.1), &[IVector::new(0, 0), IVector::new(1, 0)]);
-    let (ratio, _, notices, depth) = drop(ColliderBuilder::cuboid(5.0, 0.5).translation(Vector::new(0.0, -0.5)), voxels);
+    let voxels = ColliderBuilder::voxels(
+        Vector::new(0.1, 0.1),
+        &[IVector::new(0, 0), IVector::new(1, 0)],
+    );
+    let (ratio, _, notices, depth) = drop(
+        ColliderBuilder::cuboid(5.0, 0.5).translation(Vector::new(0.0, -0.5)),
+        voxels,
+    );
     assert_eq!(ratio, None, "topple resolved a voxel impact");
     assert_eq!(notices.len(), 1, "{notices:?}");
     assert_eq!(notices[0].reason, LeftToRapier::Shape("voxels"));
@@ -323,7 +338,10 @@ fn sensors_kinematic_bodies_and_locked_axes() {
         for _ in 0..30 {
             topple.step(&mut w);
             notices.extend(topple.take_notices());
-            assert!(w.colliders[c].compute_aabb().mins.y > -0.01, "{locks:?}: in the ground");
+            assert!(
+                w.colliders[c].compute_aabb().mins.y > -0.01,
+                "{locks:?}: in the ground"
+            );
         }
         if resolved {
             assert!(topple.stats().impacts > 0, "{locks:?}");
@@ -353,11 +371,36 @@ fn scaled_scene(l: f64) -> (PhysicsWorld, ToppleRapier, Vec<RigidBodyHandle>) {
     topple.manage(&mut w.colliders, g, m);
     let mut handles = Vec::new();
     let bodies = [
-        (ColliderBuilder::cuboid(0.2 * l, 0.1 * l), v(-1.0, 0.5), 0.0, v(0.0, 0.0)),
-        (ColliderBuilder::cuboid(0.1 * l, 0.1 * l), v(0.0, 0.8), 0.4, v(0.0, 0.0)),
-        (ColliderBuilder::ball(0.1 * l), v(1.0, 1.0), 0.0, v(0.0, 0.0)),
-        (ColliderBuilder::cuboid(0.1 * l, 0.1 * l), v(2.0, 2.0), 0.0, v(3.0, 0.0)),
-        (ColliderBuilder::cuboid(0.1 * l, 0.1 * l), v(2.5, 2.0), 0.0, v(0.0, 0.0)),
+        (
+            ColliderBuilder::cuboid(0.2 * l, 0.1 * l),
+            v(-1.0, 0.5),
+            0.0,
+            v(0.0, 0.0),
+        ),
+        (
+            ColliderBuilder::cuboid(0.1 * l, 0.1 * l),
+            v(0.0, 0.8),
+            0.4,
+            v(0.0, 0.0),
+        ),
+        (
+            ColliderBuilder::ball(0.1 * l),
+            v(1.0, 1.0),
+            0.0,
+            v(0.0, 0.0),
+        ),
+        (
+            ColliderBuilder::cuboid(0.1 * l, 0.1 * l),
+            v(2.0, 2.0),
+            0.0,
+            v(3.0, 0.0),
+        ),
+        (
+            ColliderBuilder::cuboid(0.1 * l, 0.1 * l),
+            v(2.5, 2.0),
+            0.0,
+            v(0.0, 0.0),
+        ),
     ];
     for (shape, at, angle, vel) in bodies {
         let (h, c) = w.insert(
@@ -391,7 +434,10 @@ fn metres_and_pixels_give_the_same_motion_scaled() {
             let (x, y) = (m.bodies[a].translation(), p.bodies[b].translation() / 100.0);
             largest = largest.max((x - y).length());
             let (wa, wb) = (m.bodies[a].angvel(), p.bodies[b].angvel());
-            assert!((wa - wb).abs() < 1e-6 * (1.0 + wa.abs()), "frame {frame}: ω {wa} vs {wb}");
+            assert!(
+                (wa - wb).abs() < 1e-6 * (1.0 + wa.abs()),
+                "frame {frame}: ω {wa} vs {wb}"
+            );
         }
     }
     assert!(tm.stats().impacts >= 5, "{:?}", tm.stats());

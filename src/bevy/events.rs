@@ -6,8 +6,8 @@ use bevy_rapier2d::prelude::*;
 use bevy_rapier2d::rapier::prelude::{ColliderSet, RigidBodyHandle, RigidBodySet};
 
 use crate::coupling::ImpactReport;
-use crate::rapier::LeftToRapier;
 use crate::rapier::f32::ToppleRapier;
+use crate::rapier::LeftToRapier;
 
 /// One contact of a [`ToppleImpact`].
 #[derive(Clone, Copy, Debug, PartialEq)]

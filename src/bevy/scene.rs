@@ -13,8 +13,8 @@ use super::world::{ToppleConfig, ToppleMaterial};
 use crate::coupling::{PairMaterial, ToppleSettings};
 use crate::rapier::f32::{integration_parameters, HitTracker};
 use crate::rapier::scene::{
-    expand_row, pair_material, topple_settings, BodySpec, PairLaw, Scene, SceneError,
-    SceneResult, ShapeKind,
+    expand_row, pair_material, topple_settings, BodySpec, PairLaw, Scene, SceneError, SceneResult,
+    ShapeKind,
 };
 
 /// How to spawn a scene file into a Bevy app: where, at what scale, with

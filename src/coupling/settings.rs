@@ -67,7 +67,7 @@ impl ToppleSettings {
     /// The default work budget of one engine step (LZB impulse steps times
     /// contact points, [`FallbackPolicy::max_work`]), measured in
     /// docs/bevy.md ("Bounded frames").
-    pub const DEFAULT_STEP_WORK: u64 = 200_000;
+    pub const DEFAULT_STEP_WORK: u64 = 50_000;
 }
 
 impl Default for ToppleSettings {

@@ -507,16 +507,19 @@ impl ImpactPass {
                 usize::from(ok.is_ok())
             }
             Geometry::Composite => {
-                let count = composite_manifolds(&pa.inv_mul(pb), sa, sb, reach, &mut self.manifolds);
+                let count =
+                    composite_manifolds(&pa.inv_mul(pb), sa, sb, reach, &mut self.manifolds);
                 // The same GJK miss for a sub-shape, in either order: when
                 // some sub-shapes touch and others have no points, the pair
                 // is queried again the other way round and each empty
                 // manifold takes the other query's points.
                 let partial = |ms: &[ContactManifold<(), ()>]| {
-                    ms.iter().any(|m| m.points.is_empty()) && ms.iter().any(|m| !m.points.is_empty())
+                    ms.iter().any(|m| m.points.is_empty())
+                        && ms.iter().any(|m| !m.points.is_empty())
                 };
                 if partial(&self.manifolds[..count]) {
-                    let other = composite_manifolds(&pb.inv_mul(pa), sb, sa, reach, &mut self.spare);
+                    let other =
+                        composite_manifolds(&pb.inv_mul(pa), sb, sa, reach, &mut self.spare);
                     for m in &mut self.spare[..other] {
                         flip_manifold(m);
                         if m.points.is_empty() {
