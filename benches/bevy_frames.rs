@@ -13,8 +13,8 @@
 //! cargo bench --features bevy --bench bevy_frames -- pyramid pile   # some scenes
 //! ```
 //!
-//! Prints per scene and engine the mean and worst frame (whole `update()`),
-//! topple's share, and what topple did (impacts, fallbacks, steps whose
+//! Prints per scene and engine the mean and worst frame (whole `update()`)
+//! and how many frames took longer than 1/60 s, topple's share, and what topple did (impacts, fallbacks, steps whose
 //! work budget ran out, pairs left to Rapier), and per scene whether any
 //! body's state became NaN and how far the lowest body reached below the
 //! ground's top face.
@@ -36,6 +36,8 @@ mod show;
 struct Run {
     mean_ms: f64,
     worst_ms: f64,
+    /// Frames longer than 1/60 s.
+    slow: usize,
     topple_ms: f64,
     impacts: u64,
     fallbacks: u64,
@@ -51,6 +53,7 @@ fn measure(app: &mut App, frames: usize, ground_y: f32) -> Run {
     let mut run = Run {
         mean_ms: 0.0,
         worst_ms: 0.0,
+        slow: 0,
         topple_ms: 0.0,
         impacts: 0,
         fallbacks: 0,
@@ -72,6 +75,7 @@ fn measure(app: &mut App, frames: usize, ground_y: f32) -> Run {
             );
         }
         run.worst_ms = run.worst_ms.max(ms);
+        run.slow += usize::from(ms > 1e3 / 60.0);
         let s = app.world().resource::<ToppleFrameStats>();
         run.topple_ms += 1e3 * s.topple_seconds;
         run.impacts += s.impacts;
@@ -152,11 +156,13 @@ fn print(scene: &str, frames: usize, native: &Run, topple: &Run) {
         }
     };
     println!(
-        "| {scene} | {frames} | {:.3} | {:.2} | {:.3} | {:.2} | {:.3} | {:.2} | {:.2} | {} | {} | {} | {} | {} / {} |",
+        "| {scene} | {frames} | {:.3} | {:.2} | {} | {:.3} | {:.2} | {} | {:.3} | {:.2} | {:.2} | {} | {} | {} | {} | {} / {} |",
         native.mean_ms,
         native.worst_ms,
+        native.slow,
         topple.mean_ms,
         topple.worst_ms,
+        topple.slow,
         topple.topple_ms,
         topple.mean_ms / native.mean_ms,
         topple.worst_ms / native.worst_ms,
@@ -175,9 +181,9 @@ fn main() {
         .filter(|a| !a.starts_with('-'))
         .collect();
     let want = |name: &str| wanted.is_empty() || wanted.iter().any(|w| name.contains(w.as_str()));
-    println!("| scene | frames | native mean (ms) | native worst (ms) | topple mean (ms) | topple worst (ms) | topple's own (ms/frame) | mean ratio | worst ratio | impacts | fallbacks | budget ran out | left to Rapier | below ground (native / topple) |");
+    println!("| scene | frames | native mean (ms) | native worst (ms) | native frames > 1/60 s | topple mean (ms) | topple worst (ms) | topple frames > 1/60 s | topple's own (ms/frame) | mean ratio | worst ratio | impacts | fallbacks | budget ran out | left to Rapier | below ground (native / topple) |");
     println!(
-        "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |"
+        "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |"
     );
     if want("pyramid") {
         let (f, ground) = (180, 0.0);

@@ -1,7 +1,8 @@
 //! The Bevy plugin on scenes a game builds, with `TopplePlugin::default()`:
 //! a box pyramid at rest in bevy_rapier's pixel units against native
-//! bevy_rapier, and a scene file spawned in metres and in pixels against
-//! each other and against the closed form of a flat bounce.
+//! bevy_rapier, a scene file spawned in metres and in pixels against each
+//! other and against the closed form of a flat bounce, and a pile that
+//! loses bodies mid-run beside a sensor and a kinematic body.
 
 #[path = "../examples/common/scenes.rs"]
 mod scenes;
@@ -168,4 +169,68 @@ fn a_scene_file_in_metres_and_in_pixels_gives_the_same_motion() {
         (apex - 0.05).abs() < 0.005,
         "rebound apex {apex} m, expected 0.05 m"
     );
+}
+
+/// Bodies despawned in the middle of a pile's impacts, a sensor and a
+/// moving kinematic body with materials: the app keeps running, nothing
+/// becomes NaN, the sensor and the kinematic body are each named once in a
+/// `ToppleNotice`, and impacts go on after the despawns.
+#[test]
+fn despawns_sensors_and_kinematic_bodies_in_a_pile() {
+    let mut app = scenes::headless_app(Physics::Topple);
+    let target = Target {
+        physics: Physics::Topple,
+        context: None,
+    };
+    let mut boxes = Vec::new();
+    let (mut sensor, mut paddle) = (Entity::PLACEHOLDER, Entity::PLACEHOLDER);
+    scenes::spawn_in(&mut app, |c| {
+        boxes = scenes::pile_in_layers(c, target, 4, 10);
+        let mut e = c.spawn((
+            RigidBody::Fixed,
+            Collider::cuboid(200.0, 20.0),
+            Sensor,
+            Transform::from_xyz(0.0, 60.0, 0.0),
+        ));
+        scenes::material(&mut e, target, scenes::Mat::WOOD);
+        sensor = e.id();
+        let mut e = c.spawn((
+            RigidBody::KinematicVelocityBased,
+            Collider::cuboid(40.0, 5.0),
+            // down through the falling layers into the pile, 210 px in 85 frames
+            Velocity::linear(Vec2::new(0.0, -150.0)),
+            Transform::from_xyz(0.0, 240.0, 0.0),
+        ));
+        scenes::material(&mut e, target, scenes::Mat::WOOD);
+        paddle = e.id();
+    });
+    let mut notices = Vec::new();
+    let mut impacts = |app: &mut App, frames: usize| {
+        (0..frames)
+            .map(|_| {
+                app.update();
+                notices.extend(
+                    app.world_mut()
+                        .resource_mut::<Messages<topple::bevy::ToppleNotice>>()
+                        .drain(),
+                );
+                app.world().resource::<ToppleFrameStats>().impacts
+            })
+            .sum::<u64>()
+    };
+    let before = impacts(&mut app, 25);
+    for e in boxes.iter().step_by(3) {
+        app.world_mut().despawn(*e);
+    }
+    let after = impacts(&mut app, 60);
+    assert!(before > 0 && after > 0, "{before} {after}");
+    for who in [sensor, paddle] {
+        let n = notices.iter().filter(|n| n.entity == Some(who)).count();
+        assert_eq!(n, 1, "{who}: {notices:?}");
+    }
+    let world = app.world_mut();
+    let mut q = world.query::<(&Transform, &Velocity)>();
+    for (t, v) in q.iter(world) {
+        assert!(t.translation.is_finite() && v.linear.is_finite() && v.angular.is_finite());
+    }
 }

@@ -26,8 +26,10 @@ fn material() -> PairMaterial {
 /// A world of length unit `l` (m per unit… a typical size) with gravity
 /// 9.81·l, topple with its default settings, and one material.
 fn world(l: f64) -> (PhysicsWorld, ToppleRapier, topple::coupling::MaterialId) {
-    let mut w = PhysicsWorld::default();
-    w.gravity = Vector::new(0.0, -9.81 * l);
+    let mut w = PhysicsWorld {
+        gravity: Vector::new(0.0, -9.81 * l),
+        ..PhysicsWorld::default()
+    };
     w.integration_parameters.dt = DT;
     w.integration_parameters.length_unit = l;
     let mut topple = ToppleRapier::new(ToppleSettings::default());
