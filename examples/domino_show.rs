@@ -11,7 +11,8 @@
 //! cargo run --release --features bevy --example domino_show -- --screenshot show.png --frames 90
 //! ```
 //!
-//! Flags: `--fronts N` (parallel rows, 1 to 16, default 6), `--native`
+//! Flags: `--fronts N` (parallel rows, 1 to 16, default 6; 13 fit the
+//! 720-pixel window, more run on below it), `--native`
 //! (start with native bevy_rapier), `--screenshot FILE --frames N` (save the
 //! window after N frames to FILE and the rows' state to FILE.json, then
 //! exit). Colours: a domino within 0.1 rad of upright is light grey, a
