@@ -38,4 +38,14 @@ echo "cradle --screenshot under Xvfb"
 timeout 300 xvfb-run -a -s "-screen 0 1280x720x24" \
     ./target/release/examples/cradle --screenshot "$out/cradle.png" --frames 120
 test -s "$out/cradle.png"
+
+echo "domino_show --screenshot under Xvfb (6 fronts in pixel units)"
+timeout 300 xvfb-run -a -s "-screen 0 1280x720x24" \
+    ./target/release/examples/domino_show --screenshot "$out/domino_show.png" --frames 120
+python3 .ci/check_screenshot.py "$out/domino_show.png"
+
+echo "pile --screenshot under Xvfb"
+timeout 300 xvfb-run -a -s "-screen 0 1280x720x24" \
+    ./target/release/examples/pile --screenshot "$out/pile.png" --frames 240
+test -s "$out/pile.png"
 rm -rf "$out"

@@ -1,97 +1,240 @@
-//! Frame time of a headless Bevy domino scene (the `dominoes` example's rows
-//! without the window): 1,000 and 10,000 ideal Domino T blocks at s/h 0.45,
-//! pushed, stepped at 1/60 s for 10 s of simulated time, native bevy_rapier
-//! and topple measured in the same run.
+//! Frame time of scenes a Bevy game builds, native bevy_rapier against
+//! topple, measured in one run (headless apps, 1/60 s per frame, topple's
+//! default settings):
+//!
+//! - a box pyramid standing at rest (pixel units, `TopplePlugin::default()`);
+//! - a pile of boxes dropped in layers (pixel units);
+//! - balls, boxes, capsules and convex polygons dropped in a bin (pixels);
+//! - the ideal Domino T row of 1,000 blocks at s/h 0.45 (metres);
+//! - `domino_show` with 16 fronts at once (pixel units).
 //!
 //! ```text
 //! cargo bench --features bevy --bench bevy_frames
+//! cargo bench --features bevy --bench bevy_frames -- pyramid pile   # some scenes
 //! ```
 //!
-//! Prints per case the mean and worst frame time, the real-time factor
-//! (simulated over wall time) and topple's cost over native's, for topple's
-//! default settings (a frame taken as four 1/240 s pieces) and for whole
-//! 1/60 s steps (`ToppleSettings::max_substep = None`).
+//! Prints per scene and engine the mean and worst frame (whole `update()`)
+//! and how many frames took longer than 1/60 s, topple's share, and what topple did (impacts, fallbacks, steps whose
+//! work budget ran out, pairs left to Rapier), and per scene whether any
+//! body's state became NaN and how far the lowest body reached below the
+//! ground's top face.
+
+#[path = "../examples/common/scenes.rs"]
+mod scenes;
 
 use std::time::Instant;
 
-use topple::bevy::{
-    headless_row_app, DominoRow, DominoRowState, RowPhysics, ToppleConfig, ToppleFrameStats,
-};
+use bevy::prelude::*;
+use bevy_rapier2d::prelude::*;
+use scenes::{Physics, Target};
+use topple::bevy::{headless_row_app, DominoRow, RowPhysics, ToppleFrameStats};
 use topple::domino::{Preset, RowSpec};
 
-const DT: f64 = 1.0 / 60.0;
-const FRAMES: usize = 600;
+#[path = "../examples/common/show.rs"]
+mod show;
 
-struct Case {
+struct Run {
     mean_ms: f64,
     worst_ms: f64,
-    realtime: f64,
-    hit: usize,
+    /// Frames longer than 1/60 s.
+    slow: usize,
+    topple_ms: f64,
     impacts: u64,
+    fallbacks: u64,
+    budget_spent: u64,
+    native_impacts: u64,
+    nan: bool,
+    /// Lowest point of a body's bounding box below the ground's top (px or m).
+    below_ground: f32,
 }
 
-fn run(n: usize, physics: RowPhysics, substeps: bool) -> Case {
+/// Runs `frames` updates, timing each.
+fn measure(app: &mut App, frames: usize, ground_y: f32) -> Run {
+    let mut run = Run {
+        mean_ms: 0.0,
+        worst_ms: 0.0,
+        slow: 0,
+        topple_ms: 0.0,
+        impacts: 0,
+        fallbacks: 0,
+        budget_spent: 0,
+        native_impacts: 0,
+        nan: false,
+        below_ground: 0.0,
+    };
+    let start = Instant::now();
+    for frame in 0..frames {
+        let t = Instant::now();
+        app.update();
+        let ms = 1e3 * t.elapsed().as_secs_f64();
+        if std::env::var("FRAMES_VERBOSE").is_ok() {
+            let s = app.world().resource::<ToppleFrameStats>();
+            eprintln!(
+                "frame {frame}: {ms:.2} ms, rapier steps {}, impacts {}, work {}",
+                s.rapier_steps, s.impacts, s.work
+            );
+        }
+        run.worst_ms = run.worst_ms.max(ms);
+        run.slow += usize::from(ms > 1e3 / 60.0);
+        let s = app.world().resource::<ToppleFrameStats>();
+        run.topple_ms += 1e3 * s.topple_seconds;
+        run.impacts += s.impacts;
+        run.fallbacks += s.fallbacks;
+        run.budget_spent += s.budget_spent;
+        run.native_impacts += s.native_impacts;
+    }
+    run.mean_ms = 1e3 * start.elapsed().as_secs_f64() / frames as f64;
+    run.topple_ms /= frames as f64;
+    let world = app.world_mut();
+    let mut q = world.query_filtered::<(&Transform, &Velocity, &Collider), With<RigidBody>>();
+    for (t, v, c) in q.iter(world) {
+        run.nan |= !(t.translation.is_finite() && v.linear.is_finite() && v.angular.is_finite());
+        let aabb = c.raw.compute_aabb(&bevy_rapier2d::rapier::math::Pose::new(
+            t.translation.truncate(),
+            t.rotation.to_euler(EulerRot::ZYX).0,
+        ));
+        run.below_ground = run.below_ground.max(ground_y - aabb.mins.y);
+    }
+    run
+}
+
+/// `--budget=WORK`: the step work budget instead of topple's default.
+fn budget() -> Option<u64> {
+    std::env::args().find_map(|a| {
+        a.strip_prefix("--budget=")
+            .map(|v| v.parse().expect("--budget=WORK"))
+    })
+}
+
+fn with_budget(app: &mut App) {
+    if let Some(w) = budget() {
+        app.world_mut()
+            .resource_mut::<topple::bevy::ToppleConfig>()
+            .settings
+            .fallback
+            .max_work = Some(w);
+    }
+}
+
+fn pixel_scene(
+    physics: Physics,
+    frames: usize,
+    ground_y: f32,
+    spawn: impl FnOnce(&mut Commands, Target),
+) -> Run {
+    let mut app = scenes::headless_app(physics);
+    with_budget(&mut app);
+    scenes::spawn_in(&mut app, |c| {
+        spawn(
+            c,
+            Target {
+                physics,
+                context: None,
+            },
+        )
+    });
+    measure(&mut app, frames, ground_y)
+}
+
+fn row(physics: RowPhysics, n: usize, frames: usize) -> Run {
     let p = Preset::T.params().ideal();
     let row = DominoRow {
         physics,
         ..DominoRow::new(RowSpec::new(p, 0.45 * p.block.height, n, 1.0))
     };
-    let (mut app, id) = headless_row_app(&row, DT).expect("a valid row");
-    if !substeps {
-        app.world_mut()
-            .resource_mut::<ToppleConfig>()
-            .settings
-            .max_substep = None;
-    }
-    let (mut worst, mut impacts) = (0.0f64, 0);
-    let start = Instant::now();
-    for _ in 0..FRAMES {
-        let t = Instant::now();
-        app.update();
-        worst = worst.max(t.elapsed().as_secs_f64());
-        impacts += app.world().resource::<ToppleFrameStats>().impacts;
-    }
-    let wall = start.elapsed().as_secs_f64();
-    let hit = app
-        .world()
-        .get::<DominoRowState>(id)
-        .unwrap()
-        .hit_times()
-        .len();
-    Case {
-        mean_ms: 1e3 * wall / FRAMES as f64,
-        worst_ms: 1e3 * worst,
-        realtime: FRAMES as f64 * DT / wall,
-        hit,
-        impacts,
-    }
+    let (mut app, _) = headless_row_app(&row, 1.0 / 60.0).expect("a valid row");
+    with_budget(&mut app);
+    measure(&mut app, frames, 0.0)
+}
+
+fn print(scene: &str, frames: usize, native: &Run, topple: &Run) {
+    let sane = |r: &Run| {
+        if r.nan {
+            "NaN".to_string()
+        } else {
+            format!("{:.2}", r.below_ground)
+        }
+    };
+    println!(
+        "| {scene} | {frames} | {:.3} | {:.2} | {} | {:.3} | {:.2} | {} | {:.3} | {:.2} | {:.2} | {} | {} | {} | {} | {} / {} |",
+        native.mean_ms,
+        native.worst_ms,
+        native.slow,
+        topple.mean_ms,
+        topple.worst_ms,
+        topple.slow,
+        topple.topple_ms,
+        topple.mean_ms / native.mean_ms,
+        topple.worst_ms / native.worst_ms,
+        topple.impacts,
+        topple.fallbacks,
+        topple.budget_spent,
+        topple.native_impacts,
+        sane(native),
+        sane(topple),
+    );
 }
 
 fn main() {
-    println!("| blocks | engine | mean frame (ms) | worst frame (ms) | × real time | blocks hit | impacts | topple / native |");
-    println!("| --- | --- | --- | --- | --- | --- | --- | --- |");
-    for n in [1_000, 10_000] {
-        let native = run(n, RowPhysics::Native, false);
-        let topple = run(n, RowPhysics::Topple, true);
-        let whole = run(n, RowPhysics::Topple, false);
-        for (name, c) in [
-            ("native", &native),
-            ("topple (1/240 s pieces, default)", &topple),
-            ("topple (whole 1/60 s steps)", &whole),
-        ] {
-            println!(
-                "| {n} | {name} | {:.3} | {:.2} | {:.0} | {} | {} | {} |",
-                c.mean_ms,
-                c.worst_ms,
-                c.realtime,
-                c.hit,
-                c.impacts,
-                if name != "native" {
-                    format!("{:.2}", c.mean_ms / native.mean_ms)
-                } else {
-                    "".into()
-                }
-            );
-        }
+    let wanted: Vec<String> = std::env::args()
+        .skip(1)
+        .filter(|a| !a.starts_with('-'))
+        .collect();
+    let want = |name: &str| wanted.is_empty() || wanted.iter().any(|w| name.contains(w.as_str()));
+    println!("| scene | frames | native mean (ms) | native worst (ms) | native frames > 1/60 s | topple mean (ms) | topple worst (ms) | topple frames > 1/60 s | topple's own (ms/frame) | mean ratio | worst ratio | impacts | fallbacks | budget ran out | left to Rapier | below ground (native / topple) |");
+    println!(
+        "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |"
+    );
+    if want("pyramid") {
+        let (f, ground) = (180, 0.0);
+        let spawn = |c: &mut Commands, t: Target| {
+            scenes::pyramid(c, t, 10, 40.0);
+        };
+        let native = pixel_scene(Physics::Native, f, ground, spawn);
+        let topple = pixel_scene(Physics::Topple, f, ground, spawn);
+        print("pyramid at rest, 55 boxes, px", f, &native, &topple);
+    }
+    if want("pile") {
+        let (f, ground) = (300, 0.0);
+        let spawn = |c: &mut Commands, t: Target| {
+            scenes::pile_in_layers(c, t, 10, 15);
+        };
+        let native = pixel_scene(Physics::Native, f, ground, spawn);
+        let topple = pixel_scene(Physics::Topple, f, ground, spawn);
+        print(
+            "pile of 150 boxes dropped in layers, px",
+            f,
+            &native,
+            &topple,
+        );
+    }
+    if want("bin") {
+        let (f, ground) = (300, 0.0);
+        let spawn = |c: &mut Commands, t: Target| {
+            scenes::bin(c, t, 48);
+        };
+        let native = pixel_scene(Physics::Native, f, ground, spawn);
+        let topple = pixel_scene(Physics::Topple, f, ground, spawn);
+        print(
+            "48 balls, boxes, capsules, polygons in a bin, px",
+            f,
+            &native,
+            &topple,
+        );
+    }
+    if want("row") {
+        let f = 600;
+        let native = row(RowPhysics::Native, 1_000, f);
+        let topple = row(RowPhysics::Topple, 1_000, f);
+        print("ideal Domino T row, 1,000 blocks, m", f, &native, &topple);
+    }
+    if want("show") {
+        let (f, ground) = (600, show::FLOOR_Y);
+        let spawn = |c: &mut Commands, t: Target| {
+            show::domino_show(c, t, 16);
+        };
+        let native = pixel_scene(Physics::Native, f, ground, spawn);
+        let topple = pixel_scene(Physics::Topple, f, ground, spawn);
+        print("domino_show, 16 fronts, px", f, &native, &topple);
     }
 }

@@ -89,7 +89,8 @@ fn counted_step(sw: &mut SceneWorld) -> (usize, usize) {
     let before = allocations();
     let w = &mut sw.world;
     COUNTING.with(|c| c.set(true));
-    sw.topple.begin_step(&w.islands, &w.bodies);
+    sw.topple
+        .begin_step(w.gravity, &w.integration_parameters, &w.islands, &w.bodies);
     COUNTING.with(|c| c.set(false));
     w.step_with_events(sw.topple.hooks(), &());
     COUNTING.with(|c| c.set(true));

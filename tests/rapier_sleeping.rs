@@ -77,7 +77,12 @@ fn strike(asleep: bool, ground: bool) -> Vec<([f64; 2], f64)> {
     topple.manage(&mut world.colliders, c, material);
     handles.reverse();
     handles.insert(0, ball);
-    topple.begin_step(&world.islands, &world.bodies);
+    topple.begin_step(
+        world.gravity,
+        &world.integration_parameters,
+        &world.islands,
+        &world.bodies,
+    );
     world.step_with_events(topple.hooks(), &());
     if asleep {
         for &b in &handles[1..] {

@@ -1,4 +1,5 @@
-//! What the windowed examples share: `--screenshot FILE --frames N`.
+//! What the windowed examples share: `--screenshot FILE --frames N`, the
+//! scenes of `domino_show`, `pile` and the frame benchmark, and their drawing.
 
 use std::path::PathBuf;
 
@@ -32,3 +33,7 @@ pub fn screenshot_then_exit(
         exit.write(AppExit::from_code(1));
     }
 }
+
+pub mod scenes;
+pub mod show;
+pub mod view;

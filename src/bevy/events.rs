@@ -7,6 +7,7 @@ use bevy_rapier2d::rapier::prelude::{ColliderSet, RigidBodyHandle, RigidBodySet}
 
 use crate::coupling::ImpactReport;
 use crate::rapier::f32::ToppleRapier;
+use crate::rapier::LeftToRapier;
 
 /// One contact of a [`ToppleImpact`].
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -108,6 +109,32 @@ pub(crate) fn collect(
             report: ev.report,
         });
     }
+}
+
+/// A collider with a [`crate::bevy::ToppleMaterial`] whose impacts topple
+/// leaves to Rapier (its shape, a sensor, a moving kinematic body, locked
+/// axes, another dominance group: [`LeftToRapier`]); sent once per collider
+/// and reason, with a warning in the log.
+///
+/// ```
+/// use topple::bevy::ToppleNotice;
+/// fn report(mut notices: bevy::prelude::MessageReader<ToppleNotice>) {
+///     for n in notices.read() {
+///         println!("{:?} ({}): {}", n.entity, n.shape, n.reason);
+///     }
+/// }
+/// # let _ = report;
+/// ```
+#[derive(Message, Clone, Debug, PartialEq)]
+pub struct ToppleNotice {
+    /// The Rapier context.
+    pub context: Entity,
+    /// The collider's entity (`None` if it was despawned meanwhile).
+    pub entity: Option<Entity>,
+    /// parry's name of its shape.
+    pub shape: &'static str,
+    /// Why.
+    pub reason: LeftToRapier,
 }
 
 /// Forwards Rapier's collision events of a topple context to bevy_rapier's

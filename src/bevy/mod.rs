@@ -34,8 +34,10 @@
 //! | [`ToppleConfig`] | resource: settings and pair rules |
 //! | [`ToppleFrameStats`] | resource: impacts, LZB steps, fallbacks and time of the last frame |
 //! | [`ToppleImpact`], [`ImpactPoint`] | message per resolved impact group |
+//! | [`ToppleNotice`] | message (and a warning) per collider whose impacts are left to Rapier |
 //! | [`ToppleWorld`], [`PhysicsClock`] | per context: topple's adapter, simulated time |
 //! | [`DominoRow`], [`DominoRowState`], [`RowPhysics`] | spawn a Table 1 row; its wave measures |
+//! | [`SceneSpawn`], [`SpawnedScene`] | spawn a scene file of `topple scene` (scaled into the app's units) |
 //!
 //! ```no_run
 //! use bevy::prelude::*;
@@ -59,11 +61,13 @@ mod events;
 mod headless;
 mod plugin;
 mod row;
+mod scene;
 mod step;
 mod world;
 
-pub use events::{ImpactPoint, ToppleImpact};
+pub use events::{ImpactPoint, ToppleImpact, ToppleNotice};
 pub use headless::{headless_row_app, step_frames};
 pub use plugin::{rapier_plugin, DefaultContext, TopplePlugin, ToppleSystems};
 pub use row::{DominoRow, DominoRowState, RowPhysics};
+pub use scene::{SceneSpawn, SpawnedScene};
 pub use world::{PhysicsClock, ToppleConfig, ToppleFrameStats, ToppleMaterial, ToppleWorld};

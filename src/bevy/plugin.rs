@@ -5,7 +5,7 @@ use bevy::platform::collections::HashSet;
 use bevy::prelude::*;
 use bevy_rapier2d::prelude::*;
 
-use super::events::ToppleImpact;
+use super::events::{ToppleImpact, ToppleNotice};
 use super::row::track_rows;
 use super::step::{attach_to_contexts, manage_colliders, step_contexts};
 use super::world::{ToppleConfig, ToppleFrameStats};
@@ -122,6 +122,7 @@ impl Plugin for TopplePlugin {
         app.insert_resource(self.default_context)
             .init_resource::<ToppleFrameStats>()
             .add_message::<ToppleImpact>()
+            .add_message::<ToppleNotice>()
             .configure_sets(
                 self.schedule,
                 (

@@ -87,15 +87,19 @@ impl DominoRow {
         )
     }
 
-    /// topple's settings for such a context at step `dt` (s): the defaults
-    /// with the impact threshold at 2 g dt, the approach speed a resting
-    /// contact picks up in one step (as `topple chain` sets it).
+    /// topple's settings for such a context at step `dt` (s), as `topple
+    /// chain` sets them (impact threshold 2 g dt, the approach a resting
+    /// contact picks up in one step; tolerances in the row's length unit),
+    /// with the default work budget of [`ToppleSettings`].
     pub fn topple_settings(&self, dt: f64) -> ToppleSettings {
         let solver = SolverSpec {
             dt,
             ..SolverSpec::default()
         };
-        topple_settings(&solver, [0.0, -self.spec.params.gravity])
+        ToppleSettings {
+            fallback: ToppleSettings::default().fallback,
+            ..topple_settings(&solver, self.spec.params.block.height)
+        }
     }
 
     /// bevy_rapier's configuration for such a context: the row's gravity
@@ -226,9 +230,9 @@ pub struct DominoRowState {
     pub blocks: Vec<Entity>,
     /// The ground under them.
     pub ground: Entity,
-    hits: HitTracker,
+    pub(crate) hits: HitTracker,
     /// Simulated time of the context when the row's first step began (s).
-    start: Option<f64>,
+    pub(crate) start: Option<f64>,
 }
 
 impl DominoRowState {

@@ -11,7 +11,7 @@ use bevy_rapier2d::plugin::context::SimulationToRenderTime;
 use bevy_rapier2d::prelude::*;
 use bevy_rapier2d::rapier::math::Real;
 
-use super::events::{collect, CollisionCollector, ToppleImpact};
+use super::events::{collect, CollisionCollector, ToppleImpact, ToppleNotice};
 use super::plugin::DefaultContext;
 use super::world::{PhysicsClock, ToppleConfig, ToppleFrameStats, ToppleMaterial, ToppleWorld};
 use crate::rapier::f32::StepParts;
@@ -81,6 +81,7 @@ pub(crate) struct StepMessages<'w> {
     collisions: MessageWriter<'w, CollisionEvent>,
     forces: MessageWriter<'w, ContactForceEvent>,
     impacts: MessageWriter<'w, ToppleImpact>,
+    notices: MessageWriter<'w, ToppleNotice>,
 }
 
 /// A Rapier context's parts, as one query item.
@@ -194,6 +195,7 @@ pub(crate) fn step_contexts(
         }
         let after = world.adapter.stats();
         add_frame(&mut frame, &before, &after);
+        warn_left(entity, &mut world, &colliders, &mut messages.notices);
         if let Ok(mut events) = collector.events.lock() {
             messages.collisions.write_batch(events.drain(..));
         }
@@ -224,6 +226,9 @@ fn add_frame(frame: &mut ToppleFrameStats, before: &ToppleStats, after: &ToppleS
     frame.fallbacks += fallbacks(after) - fallbacks(before);
     frame.rapier_steps += after.rapier_steps - before.rapier_steps;
     frame.topple_seconds += after.topple_seconds - before.topple_seconds;
+    frame.work += after.work - before.work;
+    frame.budget_spent += after.budget_spent - before.budget_spent;
+    frame.native_impacts += after.native_impacts - before.native_impacts;
     let t = &mut frame.totals;
     t.pairs_queried += after.pairs_queried;
     t.contact_points += after.contact_points;
@@ -235,6 +240,41 @@ fn add_frame(frame: &mut ToppleFrameStats, before: &ToppleStats, after: &ToppleS
     t.split_steps += after.split_steps;
     t.rapier_steps += after.rapier_steps;
     t.topple_seconds += after.topple_seconds;
+    t.work += after.work;
+    t.budget_spent += after.budget_spent;
+    t.native_impacts += after.native_impacts;
+}
+
+/// One warning and one [`ToppleNotice`] per collider topple leaves to
+/// Rapier, naming its entity, shape and why.
+fn warn_left(
+    context: Entity,
+    world: &mut ToppleWorld,
+    colliders: &RapierContextColliders,
+    out: &mut MessageWriter<ToppleNotice>,
+) {
+    for n in world.adapter.take_notices() {
+        let entity = colliders
+            .colliders
+            .get(n.collider)
+            .map(|co| Entity::from_bits(co.user_data as u64));
+        out.write(ToppleNotice {
+            context,
+            entity,
+            shape: n.shape,
+            reason: n.reason,
+        });
+        match entity {
+            Some(e) => warn!(
+                "topple: the {} collider of entity {e} gets Rapier's impacts, not topple's: {}",
+                n.shape, n.reason
+            ),
+            None => warn!(
+                "topple: a {} collider gets Rapier's impacts, not topple's: {}",
+                n.shape, n.reason
+            ),
+        }
+    }
 }
 
 /// Gives every new Rapier context a [`PhysicsClock`], and the default one a

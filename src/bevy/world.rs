@@ -78,8 +78,19 @@ pub struct ToppleFrameStats {
     /// LZB impulse steps this frame.
     pub lzb_steps: u64,
     /// Impacts that went through the fallback policy this frame (held,
-    /// plastic or rejected).
+    /// plastic or rejected), those cut short by the work budget included.
     pub fallbacks: u64,
+    /// Work of the LZB resolver this frame: impulse steps times contact
+    /// points, the unit of the budget
+    /// ([`crate::coupling::FallbackPolicy::max_work`], per physics step).
+    pub work: u64,
+    /// Physics steps this frame whose work budget ran out (the rest of such
+    /// a step is native Rapier).
+    pub budget_spent: u64,
+    /// Managed pairs that approached faster than the impact threshold and
+    /// got Rapier's own response this frame (colliders topple leaves to
+    /// Rapier, or after the budget ran out).
+    pub native_impacts: u64,
     /// Wall time of topple's own work this frame, Rapier excluded (s).
     pub topple_seconds: f64,
     /// Wall time of the whole physics step this frame, Rapier included (s).

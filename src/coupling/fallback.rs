@@ -42,6 +42,15 @@ pub struct FallbackPolicy {
     pub held_retry_after: usize,
     /// Impulse steps of any single attempt at most (then the next stage).
     pub max_steps: usize,
+    /// Work of all LZB attempts of one impact together at most, in impulse
+    /// steps (accepted and rejected) times the impact's contact points (the
+    /// cost of a step grows with its contacts); an impact that would need
+    /// more is finished by the next stage, at the latest the plastic solve.
+    /// `None` (default): no bound beyond `max_steps` per attempt. Engines use
+    /// it as a frame budget: [`super::ImpactGroups::resolve`] lets the groups
+    /// of one call share it.
+    #[serde(default)]
+    pub max_work: Option<u64>,
 }
 
 impl Default for FallbackPolicy {
@@ -49,6 +58,7 @@ impl Default for FallbackPolicy {
         FallbackPolicy {
             held_retry_after: 20_000,
             max_steps: 200_000,
+            max_work: None,
         }
     }
 }
@@ -87,6 +97,8 @@ pub enum Resolution {
 pub struct GroupSolver {
     lzb: ImpactSolver,
     plastic: PlasticSolver,
+    /// Work of the last impact's LZB attempts (see [`FallbackPolicy::max_work`]).
+    work: u64,
 }
 
 /// Kinetic energy after the impact exceeds the energy before by more than
@@ -124,6 +136,12 @@ impl GroupSolver {
         how
     }
 
+    /// Work of the LZB attempts of the last [`GroupSolver::solve_into`]: impulse
+    /// steps (accepted and rejected) times contact points.
+    pub fn last_work(&self) -> u64 {
+        self.work
+    }
+
     fn by_policy(
         &mut self,
         bodies: &[Body],
@@ -132,33 +150,59 @@ impl GroupSolver {
         policy: &FallbackPolicy,
         out: &mut ImpactOutcome,
     ) -> Result<Resolution, ImpactError> {
+        self.work = 0;
+        let per_step = contacts.len().max(1) as u64;
+        // steps left to all attempts together under `max_work`
+        let mut left = policy.max_work.map_or(usize::MAX, |w| {
+            usize::try_from(w / per_step).unwrap_or(usize::MAX)
+        });
         let can_hold = !settings.e0_hold && contacts.iter().any(|c| c.material.restitution == 0.0);
         let budget = if can_hold {
             policy.held_retry_after.min(policy.max_steps)
         } else {
             policy.max_steps
         };
-        let first = ImpactSettings {
-            max_steps: budget.min(settings.max_steps).max(1),
-            ..*settings
-        };
-        let result = self.lzb.solve_into(bodies, contacts, &first, out);
-        if !unfinished(&result) && !gains_energy(out) {
-            return result.map(|()| Resolution::Lzb);
-        }
-        if can_hold {
-            let held = ImpactSettings {
-                e0_hold: true,
-                max_steps: policy.max_steps.min(settings.max_steps).max(1),
+        if left > 0 {
+            let first = ImpactSettings {
+                max_steps: budget.min(settings.max_steps).min(left).max(1),
                 ..*settings
             };
+            Self::fresh(out);
+            let result = self.lzb.solve_into(bodies, contacts, &first, out);
+            self.charge(out, per_step, &mut left);
+            if !unfinished(&result) && !gains_energy(out) {
+                return result.map(|()| Resolution::Lzb);
+            }
+        }
+        if can_hold && left > 0 {
+            let held = ImpactSettings {
+                e0_hold: true,
+                max_steps: policy.max_steps.min(settings.max_steps).min(left).max(1),
+                ..*settings
+            };
+            Self::fresh(out);
             let result = self.lzb.solve_into(bodies, contacts, &held, out);
+            self.charge(out, per_step, &mut left);
             if !unfinished(&result) && !gains_energy(out) {
                 return result.map(|()| Resolution::Held);
             }
         }
         self.plastic.solve_into(bodies, contacts, out);
         Ok(Resolution::Plastic)
+    }
+
+    /// Adds an attempt's steps to the work and takes them from `left`.
+    fn charge(&mut self, out: &mut ImpactOutcome, per_step: u64, left: &mut usize) {
+        let steps = out.steps + out.rejected_steps;
+        self.work += steps as u64 * per_step;
+        *left = left.saturating_sub(steps);
+    }
+
+    /// Clears the step counts an attempt that fails its input check leaves
+    /// as they were.
+    fn fresh(out: &mut ImpactOutcome) {
+        out.steps = 0;
+        out.rejected_steps = 0;
     }
 }
 
@@ -186,6 +230,7 @@ mod tests {
         let tight = FallbackPolicy {
             held_retry_after: 3,
             max_steps: 4,
+            max_work: None,
         };
         let how = solver
             .solve_into(
@@ -201,6 +246,57 @@ mod tests {
         // the corner stops the ball (both walls are e = 0): at rest
         let v = out.bodies[0].velocity;
         assert!(v[0].abs() < 1e-6 && v[1].abs() < 1e-6, "{v:?}");
+    }
+
+    #[test]
+    fn a_work_budget_bounds_the_attempts_and_ends_plastic() {
+        let (bodies, contacts) = wedge();
+        let mut out = ImpactOutcome::default();
+        let mut solver = GroupSolver::default();
+        // two contacts: a work of 10 allows 5 steps over all attempts
+        let policy = FallbackPolicy {
+            max_work: Some(10),
+            ..FallbackPolicy::default()
+        };
+        let how = solver
+            .solve_into(
+                &bodies,
+                &contacts,
+                &ImpactSettings::fixed(1e-4),
+                &policy,
+                &mut out,
+            )
+            .unwrap();
+        assert_eq!(how, Resolution::Plastic);
+        assert!(solver.last_work() <= 10, "{}", solver.last_work());
+        assert!(out.kinetic_energy_after <= out.kinetic_energy_before);
+        // no work left: plastic at once, no LZB step taken
+        let none = FallbackPolicy {
+            max_work: Some(1),
+            ..FallbackPolicy::default()
+        };
+        let how = solver
+            .solve_into(
+                &bodies,
+                &contacts,
+                &ImpactSettings::fixed(1e-4),
+                &none,
+                &mut out,
+            )
+            .unwrap();
+        assert_eq!((how, solver.last_work()), (Resolution::Plastic, 0));
+        // without a bound the same impact finishes by the law
+        let how = solver
+            .solve_into(
+                &bodies,
+                &contacts,
+                &ImpactSettings::adaptive(1e-4),
+                &FallbackPolicy::default(),
+                &mut out,
+            )
+            .unwrap();
+        assert_ne!(how, Resolution::Plastic);
+        assert!(solver.last_work() > 0);
     }
 
     #[test]

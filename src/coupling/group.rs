@@ -144,6 +144,9 @@ pub struct ImpactGroups {
     records: Vec<ContactRecord>,
     /// The resolver's output, reused so that a steady scene allocates nothing.
     outcome: ImpactOutcome,
+    /// Work of the LZB attempts of the last call, all groups together
+    /// ([`super::FallbackPolicy::max_work`]).
+    work: u64,
 }
 
 #[inline]
@@ -199,6 +202,13 @@ impl ImpactGroups {
         &self.reports
     }
 
+    /// Work of the LZB attempts of the last [`ImpactGroups::resolve`], all
+    /// groups together: impulse steps (accepted and rejected) times each
+    /// impact's contact points ([`super::FallbackPolicy::max_work`]).
+    pub fn work(&self) -> u64 {
+        self.work
+    }
+
     /// The free bodies of group `g` of the last call (indices into the body
     /// slice it was given), in index order.
     pub fn members(&self, g: usize) -> &[usize] {
@@ -228,6 +238,7 @@ impl ImpactGroups {
         self.contact_start.clear();
         self.contact_start.push(0);
         self.body_order.clear();
+        self.work = 0;
         self.find_seeds(bodies, contacts, settings);
         if self.seeds.is_empty() {
             return 0; // the common case: nothing else is done
@@ -484,13 +495,19 @@ impl ImpactGroups {
                 c.material,
             ));
         }
+        // the groups of one call share the work budget
+        let policy = super::FallbackPolicy {
+            max_work: s.fallback.max_work.map(|w| w.saturating_sub(self.work)),
+            ..s.fallback
+        };
         let result = self.solver.solve_into(
             &self.group_bodies,
             &self.group_contacts,
             &s.impact,
-            &s.fallback,
+            &policy,
             &mut self.outcome,
         );
+        self.work += self.solver.last_work();
         let resolution = result.unwrap_or(Resolution::Rejected);
         let out = &self.outcome;
         let members = &self.body_order[self.body_start[g]..self.body_start[g + 1]];

@@ -27,14 +27,17 @@ pub struct ToppleSettings {
     /// A new closed contact starts an impact when it approaches faster than
     /// this (m/s). Slower approaches are left to the engine's contact solver.
     /// Keep it above about 2|g|Δt, the approach a resting contact picks up in
-    /// one step.
+    /// one step. (The Rapier adapter reads this and the patch's lengths per
+    /// length unit and never goes below 2|g|Δt: `crate::rapier`, "Units".)
     pub min_approach_speed: f64,
     /// The window of an impact: only free bodies within this many closed
     /// contacts of the bodies that started it take part, and contacts with
     /// bodies beyond are left out (like the paper's active window κ). `None`:
     /// the whole connected group. Default [`ToppleSettings::DEFAULT_WINDOW`].
     pub max_group_hops: Option<usize>,
-    /// What happens to an impact the LZB law cannot finish.
+    /// What happens to an impact the LZB law cannot finish. Its `max_work`
+    /// is the Rapier adapter's budget for one step, shared by the step's
+    /// impacts (default [`ToppleSettings::DEFAULT_STEP_WORK`]).
     pub fallback: FallbackPolicy,
     /// An engine adapter splits its step at the predicted instant of an
     /// impact, at most this many times per step (0: never), so that the
@@ -60,6 +63,11 @@ impl ToppleSettings {
     /// 1.714, 1.705 for windows 1 to 4, at cost 1 : 0.9 : 1.1 : 1.4;
     /// docs/game-rate.md).
     pub const DEFAULT_WINDOW: usize = 3;
+
+    /// The default work budget of one engine step (LZB impulse steps times
+    /// contact points, [`FallbackPolicy::max_work`]), measured in
+    /// docs/bevy.md ("Bounded frames").
+    pub const DEFAULT_STEP_WORK: u64 = 50_000;
 }
 
 impl Default for ToppleSettings {
@@ -69,7 +77,10 @@ impl Default for ToppleSettings {
             patch: PatchRule::default(),
             min_approach_speed: 1e-3,
             max_group_hops: Some(Self::DEFAULT_WINDOW),
-            fallback: FallbackPolicy::default(),
+            fallback: FallbackPolicy {
+                max_work: Some(Self::DEFAULT_STEP_WORK),
+                ..FallbackPolicy::default()
+            },
             max_splits: 4,
             max_substep: Some(1.0 / 240.0),
         }

@@ -18,10 +18,14 @@ mod hooks;
 mod motion;
 #[path = "adapter/pass.rs"]
 mod pass;
+#[path = "adapter/scale.rs"]
+mod scale;
 #[path = "adapter/scene_build.rs"]
 mod scene_build;
 #[path = "adapter/scene_run.rs"]
 mod scene_run;
+#[path = "adapter/support.rs"]
+mod support;
 #[path = "adapter/world.rs"]
 mod world;
 
@@ -30,6 +34,7 @@ pub use hooks::{ChainedHooks, ToppleHooks};
 pub use pass::{ImpactContact, ImpactEvent};
 pub use scene_build::{build, integration_parameters, RowInfo, SceneWorld};
 pub use scene_run::{impact_input_json, run_scene, signed_gap, HitTracker};
+pub use support::{Notice, LOCKED_INERTIA};
 pub use world::{StepParts, ToppleRapier};
 
 /// This build's precision.

@@ -7,7 +7,7 @@
 //! | --- | --- | --- |
 //! | [`f64::ToppleRapier`], [`f32::ToppleRapier`] | the adapter: Rapier step, impact pass, velocities back | per build |
 //! | [`f64::ToppleHooks`], [`f32::ToppleHooks`] | physics hook: per-pair friction, Rapier's restitution off on managed pairs | per build |
-//! | [`HookMode`], [`ToppleStats`], [`Precision`] | who resolves impacts, running totals, which build | agnostic |
+//! | [`HookMode`], [`ToppleStats`], [`Precision`], [`LeftToRapier`] | who resolves impacts, running totals, which build, why a collider's impacts are Rapier's | agnostic |
 //! | [`scene`] | TOML scenes (boxes, balls, domino rows) run with or without topple, in either precision | agnostic front, per-build worlds |
 //!
 //! Materials, λ-point patches, impact groups and the fallback policy live in
@@ -157,6 +157,19 @@ pub struct ToppleStats {
     /// Rapier steps taken (sub-steps and split pieces counted one by one).
     #[serde(skip)]
     pub rapier_steps: u64,
+    /// Work of the LZB resolver: impulse steps (accepted and rejected)
+    /// times each impact's contact points, the unit of the step budget
+    /// ([`crate::coupling::FallbackPolicy::max_work`]).
+    pub work: u64,
+    /// Steps whose work budget ran out: the impact that ran out was
+    /// finished by the fallback policy and the rest of the step was native
+    /// Rapier.
+    pub budget_spent: u64,
+    /// Managed pairs that approached faster than the impact threshold and got
+    /// Rapier's own response instead of topple's: pairs topple leaves to
+    /// Rapier ([`LeftToRapier`]) and pairs met after the step's budget ran
+    /// out.
+    pub native_impacts: u64,
     /// Wall time spent in topple's own work, Rapier's step excluded (s).
     /// Not serialized: outputs stay the same bits from run to run.
     #[serde(skip)]
@@ -175,6 +188,48 @@ impl ToppleStats {
                 Resolution::Plastic => self.plastic_fallbacks += 1,
                 Resolution::Rejected => self.rejected_impacts += 1,
             }
+        }
+    }
+}
+
+/// Why topple leaves a managed collider's impacts to Rapier's own contact
+/// solver (with the pair's friction and restitution, as native Rapier).
+///
+/// ```
+/// use topple::rapier::LeftToRapier;
+/// assert_eq!(LeftToRapier::Sensor.to_string(), "a sensor never touches anything");
+/// ```
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum LeftToRapier {
+    /// The shape has no contact manifold topple can read (parry's voxels, a
+    /// custom shape); its name is given.
+    Shape(&'static str),
+    /// A sensor never touches anything.
+    Sensor,
+    /// Its body moves but no impulse can move it: kinematic, or dynamic with
+    /// zero mass (at rest such a body is a wall).
+    Driven,
+    /// Its dynamic body has one translation axis locked, or both locked but
+    /// its rotation free: the resolver's bodies have one mass for both axes.
+    LockedAxes,
+    /// Two free bodies of different dominance groups (Rapier gives the
+    /// dominant one infinite mass against the other).
+    Dominance,
+}
+
+impl std::fmt::Display for LeftToRapier {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            LeftToRapier::Shape(name) => {
+                write!(f, "shape {name} has no contact manifold topple reads")
+            }
+            LeftToRapier::Sensor => write!(f, "a sensor never touches anything"),
+            LeftToRapier::Driven => write!(
+                f,
+                "its body moves but no impulse can move it (kinematic or zero mass)"
+            ),
+            LeftToRapier::LockedAxes => write!(f, "its body has a translation axis locked"),
+            LeftToRapier::Dominance => write!(f, "it meets a body of another dominance group"),
         }
     }
 }

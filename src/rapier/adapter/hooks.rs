@@ -6,8 +6,13 @@
 //! point at the instant the gap closes, a touching point at once); topple
 //! resolves them instead, at the instant the pair closes
 //! ([`super::ToppleRapier`]). The hook notes each pair it took points from:
-//! those pairs are the impact candidates of the step.
+//! those pairs are the impact candidates of the step. A managed pair topple
+//! cannot resolve ([`super::support`]) and every managed pair once the step's
+//! work budget is spent get Rapier's own response, with the pair's friction
+//! and restitution, as in native Rapier.
 
+use std::collections::HashSet;
+use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::Mutex;
 
 use super::backend::geometry::NEW_CONTACT_BIT;
@@ -16,6 +21,7 @@ use super::backend::prelude::{
     ColliderHandle, ContactModificationContext, PhysicsHooks, RigidBodyHandle, SolverFlags, Vector,
 };
 
+use super::support::{self, Notice};
 use crate::coupling::{MaterialId, MaterialTable, PairMaterial};
 use crate::rapier::HookMode;
 
@@ -41,10 +47,22 @@ pub struct ToppleHooks {
     pub(crate) table: MaterialTable,
     collider_material: Vec<u16>,
     pub(crate) mode: HookMode,
-    /// Points approaching faster than this (m/s) are topple's.
+    /// Points approaching faster than this (world units per second) are
+    /// topple's: the step's impact threshold
+    /// ([`super::scale::effective`]).
     pub(crate) min_approach_speed: f64,
+    /// The step's work budget is spent: every pair gets Rapier's own
+    /// response until the step ends.
+    pub(crate) stand_aside: bool,
     /// Pairs the hook took points from during the current step.
     taken: Mutex<Vec<u64>>,
+    /// Managed colliders met in pairs topple leaves to Rapier, this step.
+    left: Mutex<Vec<Notice>>,
+    /// Those reported already (not pushed again).
+    pub(crate) reported: HashSet<Notice>,
+    /// Managed pairs that approached faster than the threshold and got
+    /// Rapier's response (left to Rapier, or the budget was spent), so far.
+    native: AtomicU64,
 }
 
 const UNMANAGED: u16 = u16::MAX;
@@ -63,8 +81,24 @@ impl ToppleHooks {
             collider_material: Vec::new(),
             mode,
             min_approach_speed: 0.0,
+            stand_aside: false,
             taken: Mutex::new(Vec::new()),
+            left: Mutex::new(Vec::new()),
+            reported: HashSet::new(),
+            native: AtomicU64::new(0),
         }
+    }
+
+    /// Managed pairs that approached faster than the impact threshold and
+    /// got Rapier's own response instead of topple's, since creation.
+    pub(crate) fn native_impacts(&self) -> u64 {
+        self.native.load(Ordering::Relaxed)
+    }
+
+    /// Moves the notices of the step into `out` (appended, possibly repeated).
+    pub(crate) fn take_left(&self, out: &mut Vec<Notice>) {
+        let mut left = self.left.lock().unwrap_or_else(|e| e.into_inner());
+        out.append(&mut left);
     }
 
     pub(crate) fn set(&mut self, collider: ColliderHandle, material: Option<MaterialId>) {
@@ -116,7 +150,6 @@ impl ToppleHooks {
             *context.restitution = pair.impact.restitution as Real;
             return true;
         }
-        *context.restitution = 0.0;
         let n = *context.normal;
         let bodies = context.bodies;
         let velocity = |h: Option<RigidBodyHandle>, p: Vector| {
@@ -126,16 +159,39 @@ impl ToppleHooks {
         };
         let (b1, b2) = (context.rigid_body1, context.rigid_body2);
         let threshold = self.min_approach_speed as Real;
-        let before = context.solver_contacts.len();
-        context.solver_contacts.retain(|c| {
-            // Rapier's own notion of a lasting contact: the point existed at
-            // the last contact update and touches. Its approach in discrete
-            // time (of order g·Δt and v_t·ω·Δt on a sliding or pivoting
-            // contact) is Rapier's to hold.
+        // Rapier's own notion of a lasting contact: the point existed at the
+        // last contact update and touches. Its approach in discrete time (of
+        // order g·Δt and v_t·ω·Δt on a sliding or pivoting contact) is
+        // Rapier's to hold; so is every point slower than the threshold.
+        let rapiers = |c: &super::backend::prelude::SolverContact| {
             let lasting = c.contact_id[0] & NEW_CONTACT_BIT == 0 && c.dist <= 0.0;
             let vn = (velocity(b2, c.anchor2) - velocity(b1, c.anchor1)).dot(n);
             lasting || vn >= -threshold
-        });
+        };
+        let support = if self.stand_aside {
+            Err(None)
+        } else {
+            support::pair(
+                context.bodies,
+                context.colliders,
+                context.collider1,
+                context.collider2,
+            )
+        };
+        if let Err(notice) = support {
+            // Rapier's, as native Rapier
+            *context.restitution = pair.impact.restitution as Real;
+            if let Some(n) = notice.filter(|n| !self.reported.contains(n)) {
+                self.left.lock().unwrap_or_else(|e| e.into_inner()).push(n);
+            }
+            if !context.solver_contacts.iter().all(rapiers) {
+                self.native.fetch_add(1, Ordering::Relaxed);
+            }
+            return true;
+        }
+        *context.restitution = 0.0;
+        let before = context.solver_contacts.len();
+        context.solver_contacts.retain(|c| rapiers(c));
         if context.solver_contacts.len() < before {
             let key = pair_key(context.collider1, context.collider2);
             self.taken

@@ -15,6 +15,7 @@ use super::backend::parry::bounding_volume::BoundingVolume;
 use super::backend::parry::query::{
     ContactManifold, DefaultQueryDispatcher, PersistentQueryDispatcher,
 };
+use super::backend::parry::shape::{Shape, ShapeType};
 use super::backend::prelude::{
     BroadPhaseBvh, Collider, ColliderHandle, ColliderSet, NarrowPhase, QueryFilter, RigidBody,
     RigidBodyHandle, RigidBodySet,
@@ -22,8 +23,10 @@ use super::backend::prelude::{
 
 use super::hooks::{pair_key, ToppleHooks};
 use super::motion::{Motion, Path};
+use super::support::{self, Geometry, Role, LOCKED_INERTIA};
 use crate::coupling::{
-    for_each_contact_point, ImpactGroups, ImpactReport, ManifoldPoint, PointContact, ToppleSettings,
+    for_each_contact_point, FallbackPolicy, ImpactGroups, ImpactReport, ManifoldPoint,
+    PointContact, ToppleSettings,
 };
 use crate::impact::Body;
 
@@ -31,6 +34,7 @@ use crate::impact::Body;
 #[derive(Clone, Copy, Debug)]
 struct Candidate {
     colliders: [ColliderHandle; 2],
+    geometry: Geometry,
     key: u64,
     /// Time of impact within the step (s), `f64::INFINITY` if it does not close.
     toi: f64,
@@ -77,6 +81,20 @@ pub(crate) struct World<'a> {
     pub prediction: f64,
     /// Rapier's allowed penetration (m): a gap this small counts as touching.
     pub allowed: f64,
+    /// Rapier's length unit (world units): the scale of the world.
+    pub length_unit: f64,
+}
+
+/// What [`ImpactPass::predict`] sees ahead.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub(crate) struct Prediction {
+    /// The earliest instant (s from now) at which a managed pair that is
+    /// open now closes along straight paths at the present velocities.
+    pub closing: Option<f64>,
+    /// A managed body that moves (further than half Rapier's prediction
+    /// distance over the horizon) touches another managed collider: smooth
+    /// contact dynamics such as a leaning domino train.
+    pub moving_contact: bool,
 }
 
 /// Impacts resolved at one instant at most per step and pass: a safety net
@@ -98,20 +116,29 @@ pub(crate) struct ImpactPass {
     depth: Vec<usize>,
     slot: Vec<u32>,
     contacts: Vec<PointContact>,
-    manifold: ContactManifold<(), ()>,
+    /// The manifolds of the pair being queried: one for two convex shapes,
+    /// one per pair of sub-shapes for a composite shape.
+    manifolds: Vec<ContactManifold<(), ()>>,
+    /// The same pair queried the other way round (see `manifolds_of`).
+    spare: Vec<ContactManifold<(), ()>>,
     points: Vec<ManifoldPoint>,
     found: Vec<(ColliderHandle, bool)>,
     /// Pairs queried for the group being built.
     queried: Vec<u64>,
     /// Bounding radius (m) about the centre of mass of each body swept so
-    /// far, by arena index, with the collider count it was taken for.
-    radii: Vec<(f64, usize)>,
+    /// far, by arena index, with the body and collider count it was taken
+    /// for.
+    radii: Vec<(f64, usize, Option<RigidBodyHandle>)>,
     pub reports: Vec<ImpactReport>,
     pub events: Vec<ImpactEvent>,
     pub event_bodies: Vec<RigidBodyHandle>,
     pub event_contacts: Vec<ImpactContact>,
     pub pairs_queried: u64,
     pub contact_points: u64,
+    /// Work of the resolver so far ([`FallbackPolicy::max_work`]).
+    pub work: u64,
+    /// What is left of the step's work budget (`None`: no budget).
+    pub work_left: Option<u64>,
 }
 
 const NO_SLOT: u32 = u32::MAX;
@@ -129,10 +156,15 @@ fn v2(v: Vector) -> [f64; 2] {
     [f64::from(v.x), f64::from(v.y)]
 }
 
-/// The dynamic body a collider is attached to, if any.
+/// The body a collider is attached to if an impact moves it (a free body:
+/// [`support::role`]); walls and bodies left to Rapier give `None`.
 fn dynamic_parent(world: &World, co: &Collider) -> Option<RigidBodyHandle> {
-    co.parent()
-        .filter(|&h| world.bodies.get(h).is_some_and(RigidBody::is_dynamic))
+    co.parent().filter(|&h| {
+        world
+            .bodies
+            .get(h)
+            .is_some_and(|rb| support::role(rb) == Role::Free)
+    })
 }
 
 /// Largest distance (m) from a body's centre of mass to a point of its
@@ -159,11 +191,11 @@ impl ImpactPass {
     fn radius(&mut self, world: &World, h: RigidBodyHandle, rb: &RigidBody) -> f64 {
         let i = body_index(h);
         if self.radii.len() <= i {
-            self.radii.resize(i + 1, (0.0, usize::MAX));
+            self.radii.resize(i + 1, (0.0, usize::MAX, None));
         }
         let count = rb.colliders().len();
-        if self.radii[i].1 != count {
-            self.radii[i] = (body_radius(world, rb), count);
+        if self.radii[i].1 != count || self.radii[i].2 != Some(h) {
+            self.radii[i] = (body_radius(world, rb), count, Some(h));
         }
         self.radii[i].0
     }
@@ -249,20 +281,19 @@ impl ImpactPass {
         groups
     }
 
-    /// The earliest instant (s, from now, within `horizon`) at which a pair
-    /// that is open now closes if every awake body keeps its velocity: where
-    /// the caller splits Rapier's step, so that the impact is resolved near
-    /// its instant and the smooth forces after it act on the post-impact
-    /// velocities. Only bodies that move further than half Rapier's
-    /// prediction distance are swept; slower closings are left to the pass
-    /// after the step.
+    /// What the next `horizon` (s) holds if every awake body keeps its
+    /// velocity ([`Prediction`]): where the caller splits Rapier's step, so
+    /// that an impact is resolved near its instant and the smooth forces
+    /// after it act on the post-impact velocities, and whether it sub-steps.
+    /// Only bodies that move further than half Rapier's prediction distance
+    /// are swept; slower closings are left to the pass after the step.
     pub fn predict(
         &mut self,
         world: &World,
         hooks: &ToppleHooks,
         settings: &ToppleSettings,
         horizon: f64,
-    ) -> Option<f64> {
+    ) -> Prediction {
         self.motion.begin_prediction(horizon);
         self.candidates.clear();
         for s in 0..self.motion.starts().len() {
@@ -271,19 +302,21 @@ impl ImpactPass {
                 self.sweep(world, hooks, h);
             }
         }
-        let mut first: Option<f64> = None;
+        let mut out = Prediction::default();
+        let touch = closed_tolerance(settings).max(world.allowed);
         for k in 0..self.candidates.len() {
-            let touch = closed_tolerance(settings).max(world.allowed);
             if self.gap(world, k, 0.0, touch).is_some() {
-                continue; // touching now: Rapier's, or an impact at once
+                // touching now: Rapier's, or an impact at once
+                out.moving_contact = true;
+                continue;
             }
             let t = self.time_of_impact(world, settings, k);
-            if t.is_finite() && first.is_none_or(|f| t < f) {
-                first = Some(t);
+            if t.is_finite() && out.closing.is_none_or(|f| t < f) {
+                out.closing = Some(t);
             }
         }
         self.candidates.clear();
-        first
+        out
     }
 
     /// Writes the new velocities and end poses of every body an impact
@@ -299,7 +332,11 @@ impl ImpactPass {
             let origin = vector(path.com1) - rotation.transform_vector(local_com);
             rb.set_position(Pose::new(origin, angle), true);
             rb.set_linvel(vector(path.velocity), true);
-            rb.set_angvel(path.angular_velocity as Real, true);
+            // a body that cannot turn keeps its angular velocity (the
+            // resolver's LOCKED_INERTIA leaves it a change below 10⁻¹²)
+            if rb.mass_properties().effective_world_inv_inertia > 0.0 {
+                rb.set_angvel(path.angular_velocity as Real, true);
+            }
         }
     }
 
@@ -318,19 +355,14 @@ impl ImpactPass {
         if !self.managed(hooks, a, b) || self.candidates.iter().any(|c| c.key == key) {
             return;
         }
-        let (Some(ca), Some(cb)) = (world.colliders.get(a), world.colliders.get(b)) else {
+        // pairs topple leaves to Rapier are never candidates (the hook
+        // leaves their points to Rapier's solver)
+        let Ok(geometry) = support::pair(world.bodies, world.colliders, a, b) else {
             return;
         };
-        let same_body = ca.parent().is_some() && ca.parent() == cb.parent();
-        let convex = ca.shape().is_convex() && cb.shape().is_convex();
-        if same_body
-            || !convex
-            || (dynamic_parent(world, ca).is_none() && dynamic_parent(world, cb).is_none())
-        {
-            return;
-        }
         self.candidates.push(Candidate {
             colliders: [a, b],
+            geometry,
             key,
             toi: f64::INFINITY,
             done: false,
@@ -411,7 +443,11 @@ impl ImpactPass {
     /// Signed gap (m) of a candidate's pair at time `t`; `None` if beyond
     /// `reach` (m).
     fn gap(&mut self, world: &World, k: usize, t: f64, reach: f64) -> Option<f64> {
-        let [a, b] = self.candidates[k].colliders;
+        let Candidate {
+            colliders: [a, b],
+            geometry,
+            ..
+        } = self.candidates[k];
         let pa = self.collider_pose(world, a, t)?;
         let pb = self.collider_pose(world, b, t)?;
         let (sa, sb) = (
@@ -419,26 +455,87 @@ impl ImpactPass {
             world.colliders.get(b)?.shape(),
         );
         self.pairs_queried += 1;
-        // The manifold query (clipping for polygons) keeps its buffers; the
-        // plain contact query runs EPA when the pair penetrates, which
-        // allocates.
-        self.manifold.clear();
-        DefaultQueryDispatcher
-            .contact_manifold_convex_convex(
-                &pa.inv_mul(&pb),
-                sa,
-                sb,
-                None,
-                None,
-                reach as Real,
-                &mut self.manifold,
-            )
-            .ok()?;
-        self.manifold
-            .points
+        // A composite shape is queried sub-shape by sub-shape within the
+        // reach: only gaps near zero matter to the search.
+        let reach = match geometry {
+            Geometry::Convex => reach,
+            Geometry::Composite => reach.min(4.0 * world.prediction.max(world.allowed)),
+        };
+        let count = self.manifolds_of(geometry, &pa, sa, &pb, sb, reach as Real);
+        self.manifolds[..count]
             .iter()
-            .map(|p| f64::from(p.dist))
+            .flat_map(|m| m.points.iter().map(|p| f64::from(p.dist)))
             .min_by(f64::total_cmp)
+    }
+
+    /// Fills `manifolds` with the contact manifolds of two shapes at poses
+    /// `pa` and `pb`, points within `reach`; returns how many there are.
+    /// The manifold query (clipping for polygons) keeps its buffers; the
+    /// plain contact query runs EPA when the pair penetrates, which
+    /// allocates. Composite shapes allocate their sub-shape workspace.
+    fn manifolds_of(
+        &mut self,
+        geometry: Geometry,
+        pa: &Pose,
+        sa: &dyn Shape,
+        pb: &Pose,
+        sb: &dyn Shape,
+        reach: Real,
+    ) -> usize {
+        match geometry {
+            Geometry::Convex => {
+                // parry's GJK misses a segment touching a box flat at gaps
+                // near 10⁻⁹ when the segment is the first shape (normal along
+                // the segment, no points): the segment goes second, and the
+                // manifold is flipped back.
+                let swap = segment_like(sa) && !segment_like(sb);
+                let (pos12, s1, s2) = if swap {
+                    (pb.inv_mul(pa), sb, sa)
+                } else {
+                    (pa.inv_mul(pb), sa, sb)
+                };
+                if self.manifolds.is_empty() {
+                    self.manifolds.push(ContactManifold::new());
+                }
+                let m = &mut self.manifolds[0];
+                m.clear();
+                let ok = DefaultQueryDispatcher
+                    .contact_manifold_convex_convex(&pos12, s1, s2, None, None, reach, m);
+                if swap {
+                    flip_manifold(m);
+                }
+                usize::from(ok.is_ok())
+            }
+            Geometry::Composite => {
+                let count =
+                    composite_manifolds(&pa.inv_mul(pb), sa, sb, reach, &mut self.manifolds);
+                // The same GJK miss for a sub-shape, in either order: when
+                // some sub-shapes touch and others have no points, the pair
+                // is queried again the other way round and each empty
+                // manifold takes the other query's points.
+                let partial = |ms: &[ContactManifold<(), ()>]| {
+                    ms.iter().any(|m| m.points.is_empty())
+                        && ms.iter().any(|m| !m.points.is_empty())
+                };
+                if partial(&self.manifolds[..count]) {
+                    let other =
+                        composite_manifolds(&pb.inv_mul(pa), sb, sa, reach, &mut self.spare);
+                    for m in &mut self.spare[..other] {
+                        flip_manifold(m);
+                        if m.points.is_empty() {
+                            continue;
+                        }
+                        let same = self.manifolds[..count]
+                            .iter_mut()
+                            .find(|k| k.subshape1 == m.subshape1 && k.subshape2 == m.subshape2);
+                        if let Some(k) = same.filter(|k| k.points.is_empty()) {
+                            std::mem::swap(k, m);
+                        }
+                    }
+                }
+                count
+            }
+        }
     }
 
     /// The segment start of a candidate: the later of its bodies' path starts.
@@ -468,7 +565,7 @@ impl ImpactPass {
         let dt = self.motion.dt;
         let t0 = self.segment_start(world, k);
         let tol = closed_tolerance(settings);
-        let far = 1e3 * world.prediction.max(tol) + 1.0;
+        let far = 1e3 * world.prediction.max(tol) + world.length_unit;
         let gap = |pass: &mut Self, t: f64| pass.gap(world, k, t, far).unwrap_or(far);
         if gap(self, dt) > tol {
             return f64::INFINITY;
@@ -563,9 +660,22 @@ impl ImpactPass {
         }
         self.expand_group(world, hooks, settings, t);
         self.contact_points += self.contacts.len() as u64;
+        // the impacts of a step share its work budget
+        let budgeted = ToppleSettings {
+            fallback: FallbackPolicy {
+                max_work: self.work_left,
+                ..settings.fallback
+            },
+            ..*settings
+        };
         let groups = self
             .groups
-            .resolve(&mut self.bodies, &self.contacts, settings);
+            .resolve(&mut self.bodies, &self.contacts, &budgeted);
+        let work = self.groups.work();
+        self.work += work;
+        if let Some(left) = &mut self.work_left {
+            *left = left.saturating_sub(work);
+        }
         self.record(offset + t, groups);
         for h in &self.handles {
             self.slot[body_index(*h)] = NO_SLOT;
@@ -592,14 +702,18 @@ impl ImpactPass {
             (v2(rb.linvel()), f64::from(rb.angvel()))
         };
         let inv_i = f64::from(rb.mass_properties().effective_world_inv_inertia);
+        let mass = f64::from(rb.mass());
+        let inertia = if inv_i > 0.0 {
+            1.0 / inv_i
+        } else {
+            // a body that cannot turn (support::LOCKED_INERTIA)
+            let r = self.radius(world, h, rb).max(world.length_unit);
+            LOCKED_INERTIA * mass * r * r
+        };
         self.slot[i] = self.bodies.len() as u32;
         self.bodies.push(Body {
-            mass: f64::from(rb.mass()),
-            inertia: if inv_i > 0.0 {
-                1.0 / inv_i
-            } else {
-                f64::INFINITY
-            },
+            mass,
+            inertia,
             position: com,
             angle,
             velocity,
@@ -702,9 +816,9 @@ impl ImpactPass {
         let (Some(ca), Some(cb)) = (world.colliders.get(a), world.colliders.get(b)) else {
             return false;
         };
-        if !(ca.shape().is_convex() && cb.shape().is_convex()) {
-            return false;
-        }
+        let Ok(geometry) = support::pair(world.bodies, world.colliders, a, b) else {
+            return false; // Rapier's (support): not part of the impact
+        };
         let (Some(pa), Some(pb)) = (
             self.collider_pose(world, a, t),
             self.collider_pose(world, b, t),
@@ -713,29 +827,11 @@ impl ImpactPass {
         };
         let tol = closed_tolerance(s).max(touch);
         self.pairs_queried += 1;
-        self.manifold.clear();
-        let ok = DefaultQueryDispatcher.contact_manifold_convex_convex(
-            &pa.inv_mul(&pb),
-            ca.shape(),
-            cb.shape(),
-            None,
-            None,
-            tol as Real,
-            &mut self.manifold,
-        );
-        if ok.is_err() || self.manifold.points.is_empty() {
-            return false;
-        }
-        let normal = v2(pa.transform_vector(self.manifold.local_n1).normalize());
-        self.points.clear();
-        for p in &self.manifold.points {
-            let mid = 0.5 * (pa.transform_point(p.local_p1) + pb.transform_point(p.local_p2));
-            self.points.push(ManifoldPoint {
-                point: v2(mid),
-                dist: f64::from(p.dist),
-            });
-        }
-        if !self.points.iter().any(|p| p.dist <= tol) {
+        let count = self.manifolds_of(geometry, &pa, ca.shape(), &pb, cb.shape(), tol as Real);
+        let closed = self.manifolds[..count]
+            .iter()
+            .any(|m| m.points.iter().any(|p| f64::from(p.dist) <= tol));
+        if !closed {
             return false;
         }
         // the bodies join the group (a body new to it one hop further out)
@@ -751,18 +847,32 @@ impl ImpactPass {
             flat_tolerance: s.patch.flat_tolerance.max(closed_tolerance(s)),
             ..s.patch
         };
-        let contacts = &mut self.contacts;
-        for_each_contact_point(&self.points, &rule, |point, dist| {
-            contacts.push(PointContact {
-                bodies,
-                point,
-                normal,
-                // touching within `touch`: closed for the grouping stage
-                dist: dist.min(0.0),
-                material,
-                persistent,
-            })
-        });
+        for m in &self.manifolds[..count] {
+            // points of a sub-shape are in its own frame
+            let p1 = m.subshape_pos1().map_or(pa, |sub| pa * *sub);
+            let p2 = m.subshape_pos2().map_or(pb, |sub| pb * *sub);
+            let normal = v2(p1.transform_vector(m.local_n1).normalize());
+            self.points.clear();
+            for p in &m.points {
+                let mid = 0.5 * (p1.transform_point(p.local_p1) + p2.transform_point(p.local_p2));
+                self.points.push(ManifoldPoint {
+                    point: v2(mid),
+                    dist: f64::from(p.dist),
+                });
+            }
+            let contacts = &mut self.contacts;
+            for_each_contact_point(&self.points, &rule, |point, dist| {
+                contacts.push(PointContact {
+                    bodies,
+                    point,
+                    normal,
+                    // touching within `touch`: closed for the grouping stage
+                    dist: dist.min(0.0),
+                    material,
+                    persistent,
+                })
+            });
+        }
         true
     }
 
@@ -868,6 +978,43 @@ fn body_pose(rb: &RigidBody, com: [f64; 2], angle: f64) -> Pose {
 
 /// The closed tolerance of this build (m): the settings' tolerance, but not
 /// below what the build resolves (64 ε of the scalar type, per metre).
+/// The manifolds of a pair with a composite shape (one per pair of
+/// sub-shapes) into `out`; how many.
+fn composite_manifolds(
+    pos12: &Pose,
+    sa: &dyn Shape,
+    sb: &dyn Shape,
+    reach: Real,
+    out: &mut Vec<ContactManifold<(), ()>>,
+) -> usize {
+    out.clear();
+    let mut workspace = None;
+    let ok = DefaultQueryDispatcher.contact_manifolds(pos12, sa, sb, reach, out, &mut workspace);
+    if ok.is_ok() {
+        out.len()
+    } else {
+        0
+    }
+}
+
+/// A segment or a polyline (made of segments).
+fn segment_like(s: &dyn Shape) -> bool {
+    matches!(s.shape_type(), ShapeType::Segment | ShapeType::Polyline)
+}
+
+/// A contact manifold of shapes 1 and 2 as the manifold of 2 and 1.
+fn flip_manifold(m: &mut ContactManifold<(), ()>) {
+    std::mem::swap(&mut m.local_n1, &mut m.local_n2);
+    std::mem::swap(&mut m.subshape1, &mut m.subshape2);
+    let (pos1, pos2) = (m.subshape_pos1().copied(), m.subshape_pos2().copied());
+    m.set_subshape_pos1(pos2);
+    m.set_subshape_pos2(pos1);
+    for p in m.points.iter_mut() {
+        std::mem::swap(&mut p.local_p1, &mut p.local_p2);
+        std::mem::swap(&mut p.fid1, &mut p.fid2);
+    }
+}
+
 fn closed_tolerance(s: &ToppleSettings) -> f64 {
     s.patch
         .closed_tolerance

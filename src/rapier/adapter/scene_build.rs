@@ -69,8 +69,9 @@ pub fn build(scene: &Scene, engine: Engine) -> SceneResult<SceneWorld> {
         None => None,
     };
     let mut world = rapier_world(&scene, row.as_ref())?;
+    let length_unit = f64::from(world.integration_parameters.length_unit);
     let mut topple = match engine {
-        Engine::Rapier => ToppleRapier::new(topple_settings(&scene.solver, scene.gravity)),
+        Engine::Rapier => ToppleRapier::new(topple_settings(&scene.solver, length_unit)),
         Engine::RapierNative => ToppleRapier::native(),
     };
     let ids = register_materials(&scene, &mut topple)?;

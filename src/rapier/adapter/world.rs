@@ -13,9 +13,21 @@ use super::backend::prelude::{
 };
 
 use super::hooks::{ChainedHooks, ToppleHooks};
-use super::pass::{ImpactContact, ImpactEvent, ImpactPass, World};
+use super::pass::{ImpactContact, ImpactEvent, ImpactPass, Prediction, World};
+use super::scale;
+use super::support::{self, Notice};
 use crate::coupling::{ImpactGroups, ImpactReport, MaterialId, PairMaterial, ToppleSettings};
 use crate::rapier::{HookMode, ToppleStats};
+
+/// The world's length unit (Rapier's; 1 if it is not a positive number).
+fn length_unit(params: &IntegrationParameters) -> f64 {
+    let l = f64::from(params.length_unit);
+    if l.is_finite() && l > 0.0 {
+        l
+    } else {
+        1.0
+    }
+}
 
 /// The parts of a Rapier simulation one step needs, borrowed from wherever
 /// the app keeps them (a [`PhysicsWorld`], or bevy_rapier's components).
@@ -103,6 +115,10 @@ impl<'a> StepParts<'a> {
 pub struct ToppleRapier {
     hooks: ToppleHooks,
     settings: ToppleSettings,
+    /// The settings of the current step in the world's units.
+    effective: ToppleSettings,
+    /// Colliders left to Rapier, not taken by the app yet.
+    notices: Vec<Notice>,
     pass: ImpactPass,
     stats: ToppleStats,
     /// Colliders managed since the last step: Rapier's broad phase holds
@@ -129,6 +145,8 @@ impl ToppleRapier {
         let mut topple = ToppleRapier {
             hooks: ToppleHooks::new(mode),
             settings,
+            effective: settings,
+            notices: Vec::new(),
             pass: ImpactPass::default(),
             stats: ToppleStats::default(),
             fresh: Vec::new(),
@@ -146,7 +164,21 @@ impl ToppleRapier {
     /// Changes the settings (between steps).
     pub fn set_settings(&mut self, settings: ToppleSettings) {
         self.settings = settings;
+        self.effective = settings;
         self.hooks.min_approach_speed = settings.min_approach_speed;
+    }
+
+    /// The settings of the last step in the world's units: the impact
+    /// threshold and tolerances derived from its length unit, gravity and
+    /// step ([`super::scale`]).
+    pub fn step_settings(&self) -> &ToppleSettings {
+        &self.effective
+    }
+
+    /// The managed colliders topple left to Rapier since the last call, each
+    /// reported once per reason (see [`LeftToRapier`](crate::rapier::LeftToRapier)).
+    pub fn take_notices(&mut self) -> Vec<Notice> {
+        std::mem::take(&mut self.notices)
     }
 
     /// Adds a material; returns its id.
@@ -173,6 +205,21 @@ impl ToppleRapier {
         };
         if (material.0 as usize) >= self.hooks.table.len() {
             return false;
+        }
+        let reason = match support::geometry(co.shape()) {
+            Err(reason) => Some(reason),
+            Ok(_) if co.is_sensor() => Some(crate::rapier::LeftToRapier::Sensor),
+            Ok(_) => None,
+        };
+        if let Some(reason) = reason {
+            let notice = Notice {
+                collider,
+                shape: support::shape_name(co.shape()),
+                reason,
+            };
+            if self.hooks.reported.insert(notice) {
+                self.notices.push(notice);
+            }
         }
         self.hooks.set(collider, Some(material));
         co.set_active_hooks(co.active_hooks() | ActiveHooks::MODIFY_SOLVER_CONTACTS);
@@ -235,14 +282,21 @@ impl ToppleRapier {
     }
 
     /// One step of length `integration_parameters.dt`: Rapier with topple's
-    /// hook in front of `user_hooks`, taken as equal sub-steps no longer than
-    /// [`ToppleSettings::max_substep`], each split at the predicted impact
-    /// instants and followed by the impact pass: every impact of a managed
-    /// pair is resolved at the instant the pair closed, the bodies it changed
-    /// move on from there. Returns the number of impact groups resolved.
-    /// Never fails: an impact the LZB law cannot finish goes through the
-    /// fallback policy (counted in [`ToppleRapier::stats`]). An app that
-    /// calls Rapier's step itself uses [`ToppleRapier::begin_step`],
+    /// hook in front of `user_hooks`, followed by the impact pass: every
+    /// impact of a managed pair is resolved at the instant the pair closed,
+    /// the bodies it changed move on from there. While a managed pair is
+    /// predicted to close before the step ends, Rapier is stepped in equal
+    /// sub-steps no longer than [`ToppleSettings::max_substep`], each split
+    /// at the predicted instant (at most [`ToppleSettings::max_splits`]
+    /// times); otherwise the rest of the step is one Rapier step, so a world
+    /// at rest or between impacts costs one Rapier step as in native Rapier.
+    /// The impacts of one step share the work budget
+    /// [`crate::coupling::FallbackPolicy::max_work`]; once it is spent, the
+    /// impact that ran out is finished by the fallback policy and the rest
+    /// of the step is native Rapier (counted in [`ToppleStats`]). Lengths
+    /// and speeds of the settings are per length unit ([`super::scale`]).
+    /// Returns the number of impact groups resolved. Never fails. An app
+    /// that calls Rapier's step itself uses [`ToppleRapier::begin_step`],
     /// Rapier's step with [`ToppleRapier::hooks`], then
     /// [`ToppleRapier::end_step`] instead (one piece, no splitting).
     pub fn step_parts(
@@ -252,64 +306,45 @@ impl ToppleRapier {
         events: &dyn EventHandler,
     ) -> usize {
         self.pass.clear_step();
+        self.prepare(parts.gravity, parts.integration_parameters);
         self.insert_fresh(&mut parts);
         let dt = parts.integration_parameters.dt;
-        let substeps = self.substeps(f64::from(dt));
-        let mut groups = 0;
-        for k in 0..substeps {
-            // the last sub-step ends exactly at dt
-            let start = dt * (k as Real) / (substeps as Real);
-            let end = if k + 1 == substeps {
+        let n = self.substeps(f64::from(dt));
+        // the sub-step boundaries; the last one is exactly dt
+        let boundary = |k: usize| {
+            if k >= n {
                 dt
             } else {
-                dt * ((k + 1) as Real) / (substeps as Real)
-            };
-            groups += self.substep(&mut parts, start, end, user_hooks, events);
-        }
-        groups
-    }
-
-    /// How many equal sub-steps a step of `dt` (s) takes
-    /// ([`ToppleSettings::max_substep`], at most 1,000; native Rapier never
-    /// sub-steps).
-    fn substeps(&self, dt: f64) -> usize {
-        match self.settings.max_substep {
-            Some(h) if self.hooks.mode == HookMode::Topple && h > 0.0 && dt > h => {
-                // a hair of tolerance so that 1/60 over 1/240 is 4, not 5
-                ((dt / h) * (1.0 - 1e-9)).ceil().min(1e3) as usize
+                dt * (k as Real) / (n as Real)
             }
-            _ => 1,
-        }
-    }
-
-    /// Rapier from `start` to `end` (s into the caller's step), split at the
-    /// predicted impact instants (at most [`ToppleSettings::max_splits`]
-    /// times), each piece followed by the impact pass. Returns the number of
-    /// impact groups resolved.
-    fn substep(
-        &mut self,
-        parts: &mut StepParts<'_>,
-        start: Real,
-        end: Real,
-        user_hooks: &dyn PhysicsHooks,
-        events: &dyn EventHandler,
-    ) -> usize {
+        };
         let mut params = *parts.integration_parameters;
-        let (mut done, mut groups) = (start, 0);
-        for split in 0..=self.settings.max_splits {
-            let remaining = end - done;
-            self.begin_step(parts.islands, parts.bodies);
-            if self.hooks.mode == HookMode::Topple {
-                for &b in &self.added {
-                    self.pass.motion.record_added(parts.bodies, b);
+        let (mut now, mut k, mut splits, mut groups): (Real, usize, usize, usize) = (0.0, 0, 0, 0);
+        loop {
+            self.begin_piece(&parts);
+            let piece_end = boundary(k + 1);
+            let ahead = self.predict(&parts, dt - now);
+            let sub_step = ahead.moving_contact;
+            let end = match ahead.closing {
+                // nothing closes before the step ends: one Rapier step,
+                // unless managed bodies move in contact
+                None if sub_step => piece_end,
+                None => dt,
+                Some(t) => {
+                    let piece = f64::from(piece_end - now);
+                    if splits < self.settings.max_splits
+                        && t > piece / 64.0
+                        && t < piece * (1.0 - 1.0 / 64.0)
+                    {
+                        splits += 1;
+                        self.stats.split_steps += 1;
+                        now + t as Real
+                    } else {
+                        piece_end
+                    }
                 }
-            }
-            let h = if split < self.settings.max_splits {
-                self.split_length(parts, remaining)
-            } else {
-                remaining
             };
-            params.dt = h;
+            params.dt = end - now;
             self.stats.rapier_steps += 1;
             let hooks = ChainedHooks {
                 topple: &self.hooks,
@@ -335,14 +370,69 @@ impl ToppleRapier {
                 parts.narrow_phase,
                 parts.broad_phase,
                 &params,
-                f64::from(done),
+                f64::from(now),
             );
-            done += h;
-            if h >= remaining {
+            now = end;
+            if now >= dt || params.dt <= 0.0 {
                 break;
             }
+            if now >= piece_end {
+                while k + 1 < n && boundary(k + 1) <= now {
+                    k += 1;
+                }
+                splits = 0;
+            }
         }
+        self.finish_step();
         groups
+    }
+
+    /// How many equal sub-steps a step of `dt` (s) may take
+    /// ([`ToppleSettings::max_substep`], at most 1,000; native Rapier never
+    /// sub-steps).
+    fn substeps(&self, dt: f64) -> usize {
+        match self.settings.max_substep {
+            Some(h) if self.hooks.mode == HookMode::Topple && h > 0.0 && dt > h => {
+                // a hair of tolerance so that 1/60 over 1/240 is 4, not 5
+                ((dt / h) * (1.0 - 1e-9)).ceil().min(1e3) as usize
+            }
+            _ => 1,
+        }
+    }
+
+    /// Before a step: the settings in the world's units, the work budget,
+    /// the hook's threshold.
+    fn prepare(&mut self, gravity: Vector, params: &IntegrationParameters) {
+        self.effective = scale::effective(&self.settings, gravity, params);
+        self.hooks.min_approach_speed = self.effective.min_approach_speed;
+        self.hooks.stand_aside = false;
+        self.pass.work_left = self.settings.fallback.max_work;
+    }
+
+    /// After a step: the notices of colliders left to Rapier, once each.
+    fn finish_step(&mut self) {
+        let first = self.notices.len();
+        self.hooks.take_left(&mut self.notices);
+        let mut k = first;
+        while k < self.notices.len() {
+            if self.hooks.reported.insert(self.notices[k]) {
+                k += 1;
+            } else {
+                self.notices.swap_remove(k);
+            }
+        }
+        self.stats.native_impacts = self.hooks.native_impacts();
+    }
+
+    /// Records the start poses of a piece of the step (the awake bodies, and
+    /// the bodies added since the last step).
+    fn begin_piece(&mut self, parts: &StepParts<'_>) {
+        self.record_start(parts.islands, parts.bodies);
+        if self.hooks.mode == HookMode::Topple {
+            for &b in &self.added {
+                self.pass.motion.record_added(parts.bodies, b);
+            }
+        }
     }
 
     /// Puts the colliders managed since the last step into Rapier's broad
@@ -374,12 +464,12 @@ impl ToppleRapier {
         }
     }
 
-    /// How far to step Rapier now: to the predicted instant of the next
-    /// impact within `remaining` (s), or all of it. Pieces shorter than 1/64
-    /// of `remaining` are not split off.
-    fn split_length(&mut self, parts: &StepParts<'_>, remaining: Real) -> Real {
-        if self.hooks.mode != HookMode::Topple {
-            return remaining;
+    /// The predicted instant (s from now, within `horizon`) at which the
+    /// next managed pair closes, if any: none in native mode or once the
+    /// step's budget is spent.
+    fn predict(&mut self, parts: &StepParts<'_>, horizon: Real) -> Prediction {
+        if self.hooks.mode != HookMode::Topple || self.hooks.stand_aside || horizon <= 0.0 {
+            return Prediction::default();
         }
         let start = Instant::now();
         let params = parts.integration_parameters;
@@ -390,23 +480,31 @@ impl ToppleRapier {
             broad_phase: parts.broad_phase,
             prediction: f64::from(params.prediction_distance()),
             allowed: f64::from(params.allowed_linear_error()),
+            length_unit: length_unit(params),
         };
-        let horizon = f64::from(remaining);
         let predicted = self
             .pass
-            .predict(&world, &self.hooks, &self.settings, horizon);
+            .predict(&world, &self.hooks, &self.effective, f64::from(horizon));
         self.stats.topple_seconds += start.elapsed().as_secs_f64();
-        match predicted {
-            Some(t) if t > horizon / 64.0 && t < horizon * (1.0 - 1.0 / 64.0) => {
-                self.stats.split_steps += 1;
-                t as Real
-            }
-            _ => remaining,
-        }
+        predicted
     }
 
-    /// Before Rapier's step: records where the awake bodies start from.
-    pub fn begin_step(&mut self, islands: &IslandManager, bodies: &RigidBodySet) {
+    /// Before Rapier's step of the given gravity and parameters (an app
+    /// that steps Rapier itself): the step's settings in the world's units,
+    /// and where the awake bodies start from.
+    pub fn begin_step(
+        &mut self,
+        gravity: Vector,
+        integration_parameters: &IntegrationParameters,
+        islands: &IslandManager,
+        bodies: &RigidBodySet,
+    ) {
+        self.pass.clear_step();
+        self.prepare(gravity, integration_parameters);
+        self.record_start(islands, bodies);
+    }
+
+    fn record_start(&mut self, islands: &IslandManager, bodies: &RigidBodySet) {
         if self.hooks.mode == HookMode::Topple {
             let start = Instant::now();
             self.pass.motion.record_start(islands, bodies);
@@ -425,15 +523,16 @@ impl ToppleRapier {
         broad_phase: &BroadPhaseBvh,
         integration_parameters: &IntegrationParameters,
     ) -> usize {
-        self.pass.clear_step();
-        self.pass_after(
+        let groups = self.pass_after(
             bodies,
             colliders,
             narrow_phase,
             broad_phase,
             integration_parameters,
             0.0,
-        )
+        );
+        self.finish_step();
+        groups
     }
 
     /// The impact pass after one Rapier step that started `offset` (s) into
@@ -447,7 +546,7 @@ impl ToppleRapier {
         integration_parameters: &IntegrationParameters,
         offset: f64,
     ) -> usize {
-        if self.hooks.mode != HookMode::Topple {
+        if self.hooks.mode != HookMode::Topple || self.hooks.stand_aside {
             return 0;
         }
         let start = Instant::now();
@@ -458,14 +557,22 @@ impl ToppleRapier {
             broad_phase,
             prediction: f64::from(integration_parameters.prediction_distance()),
             allowed: f64::from(integration_parameters.allowed_linear_error()),
+            length_unit: length_unit(integration_parameters),
         };
         let first = self.pass.reports.len();
+        let work = self.pass.work;
         let dt: Real = integration_parameters.dt;
         let groups = self
             .pass
-            .run(&world, &self.hooks, &self.settings, dt, offset);
+            .run(&world, &self.hooks, &self.effective, dt, offset);
         self.pass.write_back(bodies);
         self.stats.record(&self.pass.reports[first..]);
+        self.stats.work += self.pass.work - work;
+        if self.pass.work_left == Some(0) {
+            // the budget is spent: Rapier's own response to the end of the step
+            self.hooks.stand_aside = true;
+            self.stats.budget_spent += 1;
+        }
         self.stats.topple_seconds += start.elapsed().as_secs_f64();
         groups
     }

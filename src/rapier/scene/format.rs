@@ -84,7 +84,8 @@ pub struct SolverSpec {
     /// λ points across a flat contact patch.
     pub lambda: usize,
     /// Approach speed (m/s) above which a new closed contact starts an
-    /// impact; default max(10⁻³, 2|g|Δt).
+    /// impact; default 10⁻³. Never below 2|g|Δt, the approach a resting
+    /// contact picks up in one step.
     pub min_approach_speed: Option<f64>,
     /// Impact window: bodies more than this many closed contacts away from
     /// the impact and their contacts are left out (default
@@ -99,6 +100,10 @@ pub struct SolverSpec {
     pub max_substep: Option<f64>,
     /// Gap (m) at or below which a contact point is closed.
     pub closed_tolerance: f64,
+    /// Work budget of one step: LZB impulse steps times contact points,
+    /// shared by the step's impacts ([`crate::coupling::FallbackPolicy::max_work`]);
+    /// default none (every impact runs to its end).
+    pub max_work: Option<u64>,
 }
 
 impl Default for SolverSpec {
@@ -117,6 +122,7 @@ impl Default for SolverSpec {
             max_group_hops: None,
             max_substep: None,
             closed_tolerance: 1e-9,
+            max_work: None,
         }
     }
 }

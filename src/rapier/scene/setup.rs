@@ -61,9 +61,27 @@ pub(crate) fn pair_material(l: &PairLaw) -> PairMaterial {
     )
 }
 
-/// topple's settings from a scene's solver section and gravity (m/s²).
-pub fn topple_settings(s: &SolverSpec, gravity: [f64; 2]) -> ToppleSettings {
-    let g = gravity[0].hypot(gravity[1]);
+/// topple's settings from a scene's solver section and the world's length
+/// unit (m). A scene gives its values in SI units; topple's
+/// settings are per length unit ([`crate::rapier`], "Units"), so lengths and
+/// speeds are divided by it here. The impact threshold is the scene's
+/// `min_approach_speed`, by default 10⁻³ m/s, and never below 2|g|Δt of the
+/// world's gravity and step (the adapter's floor). No work budget: a scene runs every impact to
+/// its end unless it sets `max_work`.
+///
+/// ```
+/// use topple::rapier::scene::{topple_settings, SolverSpec};
+/// let s = topple_settings(&SolverSpec::default(), 0.08);
+/// assert!((s.min_approach_speed * 0.08 - 1e-3).abs() < 1e-15);
+/// assert_eq!(s.fallback.max_work, None);
+/// ```
+pub fn topple_settings(s: &SolverSpec, length_unit: f64) -> ToppleSettings {
+    let l = if length_unit.is_finite() && length_unit > 0.0 {
+        length_unit
+    } else {
+        1.0
+    };
+    let patch = PatchRule::default();
     ToppleSettings {
         impact: match (s.tolerance, s.impulse_step) {
             (Some(t), _) => ImpactSettings::adaptive(t),
@@ -71,15 +89,19 @@ pub fn topple_settings(s: &SolverSpec, gravity: [f64; 2]) -> ToppleSettings {
             (None, None) => ToppleSettings::default().impact,
         },
         patch: PatchRule {
-            closed_tolerance: s.closed_tolerance,
+            closed_tolerance: s.closed_tolerance / l,
             lambda: s.lambda,
-            ..PatchRule::default()
+            min_patch_length: patch.min_patch_length / l,
+            flat_tolerance: patch.flat_tolerance / l,
         },
-        min_approach_speed: s.min_approach_speed.unwrap_or((2.0 * g * s.dt).max(1e-3)),
+        min_approach_speed: s.min_approach_speed.unwrap_or(1e-3) / l,
         max_group_hops: s
             .max_group_hops
             .or(ToppleSettings::default().max_group_hops),
-        fallback: FallbackPolicy::default(),
+        fallback: FallbackPolicy {
+            max_work: s.max_work,
+            ..FallbackPolicy::default()
+        },
         max_splits: s.max_splits.unwrap_or(ToppleSettings::default().max_splits),
         max_substep: match s.max_substep {
             None => ToppleSettings::default().max_substep,
