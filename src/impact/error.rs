@@ -23,7 +23,8 @@ pub enum ImpactError {
     /// The settings are unusable (step or tolerance not in (0, 1], zero step limit).
     #[error("settings: {0}")]
     InvalidSettings(String),
-    /// The impact did not end within `max_steps` steps.
+    /// The impact did not end within `max_steps` steps, or stopped making
+    /// progress (gaps closing without any point loading).
     #[error("impact did not end within {steps} steps (raise max_steps or the impulse step)")]
     StepLimit {
         /// Steps taken.

@@ -93,10 +93,18 @@ impl Integrator {
         let mut h = self.begin_segment(rk, None);
         let mut attempts = 0usize;
         let mut control = Controller::default();
+        // free flights since the last step: each one closes a gap, so more
+        // than one per point without a step in between is a loop that makes
+        // no progress (a point that closes but does not load)
+        let mut flights = 0usize;
         loop {
             if !self.any_loaded() {
                 if !self.free_flight() {
                     return Ok(StopReason::Released);
+                }
+                flights += 1;
+                if flights > self.layout.contacts + 2 {
+                    return Err(ImpactError::StepLimit { steps: out.steps });
                 }
                 self.settle();
                 h = self.begin_segment(rk, None);
@@ -110,6 +118,7 @@ impl Integrator {
                 h = h.min(sigma - self.clock.x);
             }
             rk.y0.copy_from_slice(&self.y);
+            flights = 0;
             let err = self.rk_step(rk, h);
             if !(err <= 1.0) {
                 out.rejected_steps += 1;
