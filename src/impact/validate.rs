@@ -101,7 +101,7 @@ pub(crate) fn check(
             }
         }
     }
-    if !(settings.fast_cycle >= 0.0) {
+    if settings.fast_cycle.is_nan() || settings.fast_cycle < 0.0 {
         return Err(ImpactError::InvalidSettings(format!(
             "fast_cycle {} is not >= 0",
             settings.fast_cycle

@@ -222,12 +222,12 @@ impl Integrator {
         // the inner stages need only what the right-hand side reads (the
         // velocities and compressions); the last one is the whole new state
         let core = self.layout.q(self.layout.contacts);
-        for s in 1..7 {
+        for (s, &c) in C.iter().enumerate().skip(1) {
             let upto = if s == 6 { len } else { core };
             stage_state(&mut rk.stage[..upto], &rk.y0, &rk.k, s, h);
             let (stage, k) = (&rk.stage, &mut rk.k[s]);
             self.eval(stage, k, true);
-            scale(k, self.slope(x0 + C[s] * h, stage));
+            scale(k, self.slope(x0 + c * h, stage));
             if s == 6 {
                 // the last stage is the new state (A[6] holds the weights b)
                 rk.y1.copy_from_slice(&rk.stage);

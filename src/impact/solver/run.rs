@@ -120,7 +120,7 @@ impl Integrator {
             rk.y0.copy_from_slice(&self.y);
             flights = 0;
             let err = self.rk_step(rk, h);
-            if !(err <= 1.0) {
+            if err.is_nan() || err > 1.0 {
                 out.rejected_steps += 1;
                 if err.is_nan() && matches!(self.clock.variable, Variable::End { .. }) {
                     // the ending point stopped separating: back to time
@@ -192,7 +192,7 @@ impl Integrator {
             Variable::Root => (self.clock.x + h).powi(2) - self.clock.x.powi(2),
             Variable::End { sigma, .. } => h / sigma.max(f64::MIN_POSITIVE) * self.scales.time,
         };
-        !(t > self.min_step)
+        t.is_nan() || t <= self.min_step
     }
 
     /// Starts a segment at the present state and returns its first step (in
