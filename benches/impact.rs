@@ -44,7 +44,8 @@ use criterion::{criterion_group, criterion_main, Criterion};
 use topple::impact::capture::CapturedImpact;
 use topple::impact::{Body, BodyVelocity, Contact, ContactMaterial, ImpactSettings, ImpactSolver};
 
-/// One impact and its converged answer ([vx, vy, ω] per body).
+/// One impact and its converged answer ([vx, vy, ω] per body; empty when
+/// neither converged run finished within its step limit).
 struct Impact {
     bodies: Vec<Body>,
     contacts: Vec<Contact>,
@@ -149,11 +150,11 @@ fn leaning(elastic: bool) -> Class {
 fn converged(name: &'static str, list: Vec<(Vec<Body>, Contacts)>) -> Class {
     let tight = ImpactSettings {
         fast_cycle: 0.0,
-        max_steps: 100_000_000,
+        max_steps: 1_000_000,
         ..ImpactSettings::adaptive(1e-10)
     };
     let second = ImpactSettings {
-        max_steps: 100_000_000,
+        max_steps: 1_000_000,
         ..ImpactSettings::adaptive_impulse(1e-6)
     };
     eprintln!("converging {name} ...");
@@ -162,15 +163,20 @@ fn converged(name: &'static str, list: Vec<(Vec<Body>, Contacts)>) -> Class {
     let impacts = list
         .into_iter()
         .map(|(bodies, contacts)| {
-            let out = solver.solve(&bodies, &contacts, &tight).unwrap();
-            let reference = velocities(&out.bodies);
-            let other = solver.solve(&bodies, &contacts, &second).unwrap();
+            let first = solver.solve(&bodies, &contacts, &tight).ok();
+            let other = solver.solve(&bodies, &contacts, &second).ok();
+            let reference = match (&first, &other) {
+                (Some(out), _) | (None, Some(out)) => velocities(&out.bodies),
+                (None, None) => Vec::new(),
+            };
             let impact = Impact {
                 bodies,
                 contacts,
                 reference,
             };
-            check = check.max(error(&impact, &velocities(&other.bodies)));
+            if let (Some(_), Some(other)) = (&first, &other) {
+                check = check.max(error(&impact, &velocities(&other.bodies)));
+            }
             impact
         })
         .collect();
@@ -224,29 +230,61 @@ fn error(impact: &Impact, got: &[[f64; 3]]) -> f64 {
     worst / speed
 }
 
+/// The step controls compared, each with a step limit of 10⁶.
 fn settings() -> Vec<(&'static str, ImpactSettings)> {
+    let limited = |s: ImpactSettings| ImpactSettings {
+        max_steps: 1_000_000,
+        ..s
+    };
     vec![
-        ("paper: fixed ΔP = 10⁻⁴ P₀", ImpactSettings::fixed(1e-4)),
         (
-            "before: adaptive impulse 10⁻⁴",
-            ImpactSettings::adaptive_impulse(1e-4),
+            "paper: fixed ΔP = 10⁻⁴ P₀",
+            limited(ImpactSettings::fixed(1e-4)),
         ),
-        ("default: in time 10⁻⁵", ImpactSettings::default()),
+        (
+            "adaptive impulse 10⁻⁴ (plugin default)",
+            limited(ImpactSettings::adaptive_impulse(1e-4)),
+        ),
+        ("in time 10⁻⁴", limited(ImpactSettings::adaptive(1e-4))),
+        (
+            "in time 2·10⁻⁶ (default)",
+            limited(ImpactSettings::default()),
+        ),
     ]
 }
 
-/// Solves every impact of a class: (median steps, mean steps, worst error).
-fn measure(class: &Class, solver: &mut ImpactSolver, s: &ImpactSettings) -> (usize, f64, f64) {
+/// What one step control does on a class.
+struct Measured {
+    median: usize,
+    mean: f64,
+    worst: f64,
+    /// Impacts that ended in an error (the step limit).
+    failed: usize,
+}
+
+/// Solves every impact of a class.
+fn measure(class: &Class, solver: &mut ImpactSolver, s: &ImpactSettings) -> Measured {
     let mut steps = Vec::new();
-    let mut worst = 0.0f64;
+    let (mut worst, mut failed) = (0.0f64, 0);
     for impact in &class.impacts {
-        let out = solver.solve(&impact.bodies, &impact.contacts, s).unwrap();
-        steps.push(out.steps);
-        worst = worst.max(error(impact, &velocities(&out.bodies)));
+        match solver.solve(&impact.bodies, &impact.contacts, s) {
+            Ok(out) => {
+                steps.push(out.steps);
+                if !impact.reference.is_empty() {
+                    worst = worst.max(error(impact, &velocities(&out.bodies)));
+                }
+            }
+            Err(_) => failed += 1,
+        }
     }
-    let mean = steps.iter().sum::<usize>() as f64 / steps.len() as f64;
+    let mean = steps.iter().sum::<usize>() as f64 / steps.len().max(1) as f64;
     steps.sort_unstable();
-    (steps[steps.len() / 2], mean, worst)
+    Measured {
+        median: steps.get(steps.len() / 2).copied().unwrap_or(0),
+        mean,
+        worst,
+        failed,
+    }
 }
 
 fn bench(c: &mut Criterion) {
@@ -262,18 +300,22 @@ fn bench(c: &mut Criterion) {
     ];
     let mut solver = ImpactSolver::new();
     println!(
-        "\n| class | impacts | step control | steps (median) | steps (mean) | time per impact | error / speed | check |"
+        "\n| class | impacts | step control | steps (median) | steps (mean) | time per impact | error / speed | failed | check |"
     );
-    println!("| --- | ---: | --- | ---: | ---: | ---: | ---: | ---: |");
+    println!("| --- | ---: | --- | ---: | ---: | ---: | ---: | ---: | ---: |");
     for class in &classes {
         for (label, s) in settings() {
             let start = Instant::now();
-            let (median, mean, err) = measure(class, &mut solver, &s);
+            let m = measure(class, &mut solver, &s);
             let time = start.elapsed() / class.impacts.len() as u32;
             println!(
-                "| {} | {} | {label} | {median} | {mean:.0} | {time:.1?} | {err:.1e} | {:.0e} |",
+                "| {} | {} | {label} | {} | {:.0} | {time:.1?} | {:.1e} | {} | {:.0e} |",
                 class.name,
                 class.impacts.len(),
+                m.median,
+                m.mean,
+                m.worst,
+                m.failed,
                 class.check
             );
         }
@@ -285,7 +327,7 @@ fn bench(c: &mut Criterion) {
             group.bench_function(label, |b| {
                 b.iter(|| {
                     for impact in &class.impacts {
-                        solver.solve(&impact.bodies, &impact.contacts, &s).unwrap();
+                        let _ = solver.solve(&impact.bodies, &impact.contacts, &s);
                     }
                 })
             });
