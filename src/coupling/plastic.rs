@@ -19,6 +19,7 @@
 //! [`PlasticSolver::MAX_SWEEPS`]; the result then leaves approach speeds below
 //! that tolerance times the velocity scale.
 
+use crate::impact::contact::cross;
 use crate::impact::{Body, BodyVelocity, Contact, ContactImpulse, ImpactOutcome};
 
 /// One contact in the solver's flat form: body slots (the world is the last
@@ -62,11 +63,6 @@ pub struct PlasticSolver {
     impulse: Vec<[f64; 2]>,
 }
 
-#[inline]
-fn cross(r: [f64; 2], v: [f64; 2]) -> f64 {
-    r[0] * v[1] - r[1] * v[0]
-}
-
 impl PlasticSolver {
     /// Sweeps stop when the largest impulse change of a sweep is below this
     /// fraction of the group's impulse scale (dimensionless).
@@ -93,7 +89,6 @@ impl PlasticSolver {
     }
 
     fn load(&mut self, bodies: &[Body], contacts: &[Contact]) {
-        let world = bodies.len();
         self.inv_mass.clear();
         self.inv_inertia.clear();
         self.velocity.clear();
@@ -110,20 +105,9 @@ impl PlasticSolver {
         self.velocity.push([0.0; 3]);
         self.rows.clear();
         for c in contacts {
-            let a = c.bodies[0].unwrap_or(world);
-            let b = c.bodies[1].unwrap_or(world);
-            let len = c.normal[0].hypot(c.normal[1]);
-            let n = [c.normal[0] / len, c.normal[1] / len];
-            let t = [-n[1], n[0]];
-            let arm = |slot: usize| {
-                if slot == world {
-                    [0.0, 0.0]
-                } else {
-                    let p = bodies[slot].position;
-                    [c.point[0] - p[0], c.point[1] - p[1]]
-                }
-            };
-            let (ra, rb) = (arm(a), arm(b));
+            let frame = c.frame(bodies);
+            let (a, b, n, t) = (frame.a, frame.b, frame.normal, frame.tangent);
+            let (ra, rb) = (frame.arm_a, frame.arm_b);
             let (a_rn, a_rt, b_rn, b_rt) = (cross(ra, n), cross(ra, t), cross(rb, n), cross(rb, t));
             let w = |arm_a: f64, arm_b: f64| {
                 self.inv_mass[a]

@@ -138,4 +138,50 @@ impl Contact {
     pub fn tangent(&self) -> [f64; 2] {
         [-self.normal[1], self.normal[0]]
     }
+
+    /// The contact's frame among `bodies`, the world being slot
+    /// `bodies.len()`: the body slots, the normal made unit, the tangent and
+    /// each body's arm (contact point minus centre of mass, m; zero for the
+    /// world). One definition for every solver that builds rows from it.
+    #[inline]
+    pub(crate) fn frame(&self, bodies: &[super::Body]) -> ContactFrame {
+        let world = bodies.len();
+        let a = self.bodies[0].unwrap_or(world);
+        let b = self.bodies[1].unwrap_or(world);
+        let len = self.normal[0].hypot(self.normal[1]);
+        let normal = [self.normal[0] / len, self.normal[1] / len];
+        let arm = |slot: usize| {
+            if slot == world {
+                [0.0, 0.0]
+            } else {
+                let p = bodies[slot].position;
+                [self.point[0] - p[0], self.point[1] - p[1]]
+            }
+        };
+        ContactFrame {
+            a,
+            b,
+            normal,
+            tangent: [-normal[1], normal[0]],
+            arm_a: arm(a),
+            arm_b: arm(b),
+        }
+    }
+}
+
+/// See [`Contact::frame`].
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct ContactFrame {
+    pub a: usize,
+    pub b: usize,
+    pub normal: [f64; 2],
+    pub tangent: [f64; 2],
+    pub arm_a: [f64; 2],
+    pub arm_b: [f64; 2],
+}
+
+/// The planar cross product r × v (the moment arm of v about r's origin).
+#[inline]
+pub(crate) fn cross(r: [f64; 2], v: [f64; 2]) -> f64 {
+    r[0] * v[1] - r[1] * v[0]
 }

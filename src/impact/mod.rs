@@ -30,7 +30,7 @@
 pub mod audit;
 mod body;
 pub mod capture;
-mod contact;
+pub(crate) mod contact;
 mod error;
 mod impulse;
 mod outcome;

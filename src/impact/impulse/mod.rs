@@ -47,6 +47,7 @@
 //! has closed. This makes the e = 1 result equal to the compliant model
 //! F = k δ^α integrated in time, separations and re-contacts included.
 
+use super::contact::cross;
 use super::{
     Body, BodyVelocity, Contact, ContactImpulse, ImpactError, ImpactOutcome, ImpactSettings,
     StopReason,
@@ -279,11 +280,6 @@ fn warped_nodes(k: f64) -> [NodeWarp; 4] {
     GAUSS_4.map(|(node, _)| (node.powf(k), k * node.powf(k - 1.0)))
 }
 
-#[inline]
-fn cross(r: [f64; 2], v: [f64; 2]) -> f64 {
-    r[0] * v[1] - r[1] * v[0]
-}
-
 impl ImpulseStepper {
     /// Resolves one validated impact into `out` with a fixed or an adaptive
     /// impulse step. Errors: the step limit or a non-finite state.
@@ -350,7 +346,6 @@ impl ImpulseStepper {
 
     /// Builds rows, velocities and scales; sizes every buffer.
     fn load(&mut self, bodies: &[Body], contacts: &[Contact]) {
-        let world = bodies.len();
         self.inv_mass.clear();
         self.inv_inertia.clear();
         self.velocity.clear();
@@ -371,20 +366,9 @@ impl ImpulseStepper {
 
         self.rows.clear();
         for c in contacts {
-            let a = c.bodies[0].unwrap_or(world);
-            let b = c.bodies[1].unwrap_or(world);
-            let len = c.normal[0].hypot(c.normal[1]);
-            let normal = [c.normal[0] / len, c.normal[1] / len];
-            let tangent = [-normal[1], normal[0]];
-            let arm = |slot: usize| {
-                if slot == world {
-                    [0.0, 0.0]
-                } else {
-                    let p = bodies[slot].position;
-                    [c.point[0] - p[0], c.point[1] - p[1]]
-                }
-            };
-            let (ra, rb) = (arm(a), arm(b));
+            let frame = c.frame(bodies);
+            let (a, b, normal, tangent) = (frame.a, frame.b, frame.normal, frame.tangent);
+            let (ra, rb) = (frame.arm_a, frame.arm_b);
             let (a_rn, a_rt, b_rn, b_rt) = (
                 cross(ra, normal),
                 cross(ra, tangent),

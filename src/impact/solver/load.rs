@@ -9,6 +9,7 @@
 //! impulses reported explain the velocities) and the time since the impact
 //! started (the independent variable is not always the time, see `Clock`).
 
+use super::super::contact::cross;
 use super::super::{Body, Contact};
 use super::law::Law;
 use super::{Integrator, PatchMode, PointState};
@@ -152,11 +153,6 @@ impl Layout {
     }
 }
 
-#[inline]
-fn cross(r: [f64; 2], v: [f64; 2]) -> f64 {
-    r[0] * v[1] - r[1] * v[0]
-}
-
 /// Same direction, same arms: the tangential rows of two points coincide.
 fn same_axis(x: &Axis, y: &Axis, length: f64) -> bool {
     let close = |p: f64, q: f64, scale: f64| (p - q).abs() <= 1e-9 * scale;
@@ -207,20 +203,9 @@ impl Integrator {
         let mut tangents = std::mem::take(&mut self.tangents);
         tangents.clear();
         for c in contacts {
-            let a = c.bodies[0].unwrap_or(world);
-            let b = c.bodies[1].unwrap_or(world);
-            let len = c.normal[0].hypot(c.normal[1]);
-            let n = [c.normal[0] / len, c.normal[1] / len];
-            let t = [-n[1], n[0]];
-            let arm = |slot: usize| {
-                if slot == world {
-                    [0.0, 0.0]
-                } else {
-                    let p = bodies[slot].position;
-                    [c.point[0] - p[0], c.point[1] - p[1]]
-                }
-            };
-            let (ra, rb) = (arm(a), arm(b));
+            let frame = c.frame(bodies);
+            let (a, b, n, t) = (frame.a, frame.b, frame.normal, frame.tangent);
+            let (ra, rb) = (frame.arm_a, frame.arm_b);
             let normal = Axis {
                 dir: n,
                 arm_a: cross(ra, n),
