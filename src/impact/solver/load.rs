@@ -124,6 +124,11 @@ pub(super) struct Scales {
     /// The shortest time scale of the points approaching at the start (s,
     /// law.rs).
     pub time: f64,
+    /// Accelerations within ± this are taken as zero (m/s²): the rate
+    /// threshold over the time scale. A sliding patch whose slip and slip
+    /// acceleration are both zero to this rounding has its slip fixed by
+    /// other rows (a closed loop of stuck patches) and keeps its mode.
+    pub accel: f64,
 }
 
 /// Offsets of the state vector's parts.
@@ -281,6 +286,11 @@ impl Integrator {
             rate: 1e-9 * speed,
             onset: 1e-3 * speed,
             time: if time.is_finite() { time } else { 0.0 },
+            accel: if time.is_finite() && time > 0.0 {
+                1e-9 * speed / time
+            } else {
+                0.0
+            },
         };
         self.generation = 0;
         self.clock = super::Clock::default();

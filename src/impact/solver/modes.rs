@@ -107,15 +107,12 @@ impl Integrator {
             let members = &self.members[patch.first..patch.first + patch.count];
             let slip = rate(&self.y, patch.a, patch.b, &patch.tangent);
             let now = self.patch_modes[p];
-            let next = if patch.frictionless() {
+            let next = if patch.frictionless() || !members.iter().any(|&i| self.carries_load(i)) {
+                // no load, no friction: a stuck row without load would
+                // carry whatever force the other stuck rows leave it
                 PatchMode::Idle
             } else if patch.no_slip() {
-                // sticks while it carries load, has no friction otherwise
-                if members.iter().any(|&i| self.carries_load(i)) {
-                    PatchMode::Stick
-                } else {
-                    PatchMode::Idle
-                }
+                PatchMode::Stick
             } else {
                 match now {
                     PatchMode::Stick => {
@@ -128,11 +125,13 @@ impl Integrator {
                     }
                     PatchMode::Slide(s) if s * slip > thr => now,
                     PatchMode::Slide(s) if slip.abs() <= thr => {
-                        // at zero slip: keeps sliding only if pushed that way
-                        if s * rate(slope, patch.a, patch.b, &patch.tangent) > 0.0 {
-                            now
-                        } else {
+                        // at zero slip: sticks if the push turns the slip
+                        // back; keeps sliding if it pushes the slip on or
+                        // leaves it at zero (its slip is held by other rows)
+                        if s * rate(slope, patch.a, patch.b, &patch.tangent) < -self.scales.accel {
                             PatchMode::Stick
+                        } else {
+                            now
                         }
                     }
                     _ if slip.abs() <= thr => PatchMode::Stick,

@@ -68,7 +68,7 @@ impl Integrator {
     #[inline]
     pub(super) fn onset_matters(&self, i: usize) -> bool {
         let p = self.rows[i].patch;
-        self.patches[p].no_slip() && self.patch_modes[p] == PatchMode::Idle
+        self.patch_modes[p] == PatchMode::Idle && !self.patches[p].frictionless()
     }
 
     /// dy/dt at state `y` into `dy`. With `probe`, notes the points and

@@ -97,6 +97,12 @@ impl Integrator {
         // than one per point without a step in between is a loop that makes
         // no progress (a point that closes but does not load)
         let mut flights = 0usize;
+        // switches landed on one after another without time moving on: the
+        // modes cycle at one instant (a set of stick/slip conditions with
+        // no consistent choice); more than any settling could need is a
+        // loop that makes no progress
+        let mut standstill = 0usize;
+        let standstill_cap = 8 + 2 * (self.rows.len() + self.patches.len());
         loop {
             if !self.any_loaded() {
                 if !self.free_flight() {
@@ -147,7 +153,16 @@ impl Integrator {
             // the controller's next step, in time
             let next = self.step_time(rk) * grow;
             if let Some(theta) = switch {
+                let before = self.y[self.layout.time()];
                 self.land(rk, theta);
+                if self.y[self.layout.time()] - before <= self.min_step {
+                    standstill += 1;
+                    if standstill > standstill_cap {
+                        return Err(ImpactError::StepLimit { steps: out.steps });
+                    }
+                } else {
+                    standstill = 0;
+                }
                 if !matches!(self.clock.variable, Variable::End { .. }) {
                     self.pace = next;
                 }
