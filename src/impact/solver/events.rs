@@ -168,7 +168,11 @@ impl Integrator {
                 if let PatchMode::Slide(s) = self.patch_modes[p] {
                     let patch = &self.patches[p];
                     let g = rk.dense_functional(&terms(patch.a, patch.b, &patch.tangent));
-                    out[0] = Some(Watch::one(Switch::SlipStops(p), (g, -s, thr)));
+                    // a patch that broke loose at zero slip may start a
+                    // rounding's width on the wrong side: its slip stops
+                    // only once it falls a further `thr` below that
+                    let behind = (-s * horner(&g, 0.0)).max(0.0);
+                    out[0] = Some(Watch::one(Switch::SlipStops(p), (g, -s, thr + behind)));
                 }
             }
         }
