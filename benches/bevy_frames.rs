@@ -11,6 +11,7 @@
 //! ```text
 //! cargo bench --features bevy --bench bevy_frames
 //! cargo bench --features bevy --bench bevy_frames -- pyramid pile   # some scenes
+//! cargo bench --features bevy --bench bevy_frames -- --tolerance=1e-4 # time-domain resolver
 //! ```
 //!
 //! Prints per scene and engine the mean and worst frame (whole `update()`)
@@ -106,7 +107,22 @@ fn budget() -> Option<u64> {
     })
 }
 
+/// `--tolerance=TOL`: the time-domain resolver at this tolerance
+/// (`ImpactSettings::adaptive`) instead of topple's default impulse stepping.
+fn tolerance() -> Option<f64> {
+    std::env::args().find_map(|a| {
+        a.strip_prefix("--tolerance=")
+            .map(|v| v.parse().expect("--tolerance=TOL"))
+    })
+}
+
 fn with_budget(app: &mut App) {
+    if let Some(t) = tolerance() {
+        app.world_mut()
+            .resource_mut::<topple::bevy::ToppleConfig>()
+            .settings
+            .impact = topple::impact::ImpactSettings::adaptive(t);
+    }
     if let Some(w) = budget() {
         app.world_mut()
             .resource_mut::<topple::bevy::ToppleConfig>()
