@@ -112,13 +112,16 @@ fn heel_contacts_run_an_ideal_row_to_its_end() {
     agree_with_the_row_without_heels(&row, &with, 0.005);
 }
 
+/// Snapshots of a row: time (s) and (x, y, φ) of every block.
+type Looks = Vec<(f64, Vec<[f64; 3]>)>;
+
 /// Runs `row` (the paper's integrator at its default step) with heel
 /// contacts as the stress sweep does, up to the last hit, watched every 2 ms
 /// by the sweep's overlap check (`RowWatch`: every corner of every block
 /// against every face of every other block and the ground, computed from
 /// the block poses alone, independent of the engine's contact set).
 /// Returns the watch, the report and the looks (time, poses).
-fn watched(row: &RowSpec) -> (RowWatch, ChainReport, Vec<(f64, Vec<[f64; 3]>)>) {
+fn watched(row: &RowSpec) -> (RowWatch, ChainReport, Looks) {
     let t_end = 1.5;
     let settings = Settings {
         heel_contacts: true,
@@ -144,7 +147,7 @@ fn watched(row: &RowSpec) -> (RowWatch, ChainReport, Vec<(f64, Vec<[f64; 3]>)>) 
 
 /// The first time (s) a block lies within 10° of flat on the ground while
 /// the block behind it is still falling (tilt 20°–80°).
-fn flat_under_falling(looks: &[(f64, Vec<[f64; 3]>)]) -> Option<f64> {
+fn flat_under_falling(looks: &Looks) -> Option<f64> {
     let (flat, falling) = (80f64.to_radians(), 20f64.to_radians());
     looks.iter().find_map(|(t, q)| {
         (1..q.len())
