@@ -100,6 +100,29 @@ pub(crate) struct Dynamics {
     proj_start: Vec<f64>,
     proj_owner: Vec<(usize, bool)>,
     proj_drop: Vec<usize>,
+    // buffers of `relaxed_forces`
+    relax_rows: Vec<RelaxRow>,
+    relax_acc: Vec<[f64; 3]>,
+}
+
+/// One candidate contact in the relaxation of [`Dynamics::relaxed_forces`]:
+/// its window-local bodies, Jacobian rows, velocity terms, the inverse of
+/// its diagonal Delassus entries, its friction and its forces.
+#[derive(Clone, Copy, Debug, Default)]
+struct RelaxRow {
+    bodies: [Option<usize>; 2],
+    jn: [[f64; 3]; 2],
+    jt: [[f64; 3]; 2],
+    sn: f64,
+    st: f64,
+    inv_wnn: f64,
+    inv_wtt: f64,
+    mu: f64,
+    mus: f64,
+    /// Slipping faster than the stick threshold: sliding friction along −v_t.
+    slip: Option<f64>,
+    fnn: f64,
+    ft: f64,
 }
 
 /// Constants of the row needed by the dynamics.
@@ -464,5 +487,103 @@ impl Dynamics {
         self.proj_start = y0;
         self.proj_owner = owner;
         self.proj_drop = drop;
+    }
+
+    /// The contact forces of every candidate (block, slot, v_t) by
+    /// projected Gauss–Seidel relaxation of the frictional contact problem
+    /// at acceleration level (Eqs. 18–20): each contact in turn takes the
+    /// normal force that stops its own normal acceleration, at least 0, then
+    /// the tangential force that stops its own slip acceleration, within
+    /// ±μ_s F_n — or −μ F_n along v_t where it slips faster than `v_stick`
+    /// (m/s). Every update is a projection in the metric of the inverse
+    /// mass, so the relaxation does not cycle as a mode search can; after
+    /// `sweeps` sweeps the forces give a mode to be checked. Returns the
+    /// forces (normal, tangential), one pair per candidate, in `out`.
+    pub fn relaxed_forces(
+        &mut self,
+        rc: &RowConst,
+        view: &View,
+        candidates: impl Iterator<Item = (usize, usize, f64)>,
+        v_stick: f64,
+        sweeps: usize,
+        out: &mut Vec<[f64; 2]>,
+    ) {
+        let g = rc.p.gravity;
+        let nb = view.hi - view.lo;
+        self.relax_acc.clear();
+        self.relax_acc.resize(nb, [0.0, -g, 0.0]);
+        self.relax_rows.clear();
+        for (block, slot, vt) in candidates {
+            let gm = rc.geom(view, block, slot).expect("slot exists");
+            let k = rc.kin(view, &gm);
+            let bodies = [view.local(Some(gm.corner)), view.local(gm.face)];
+            let w = |j: &[[f64; 3]; 2]| {
+                let mut w = 0.0;
+                for (b, body) in bodies.iter().enumerate() {
+                    if body.is_some() {
+                        w += dot3(j[b], rc.minv(j[b]));
+                    }
+                }
+                w
+            };
+            let inv = |w: f64| if w > 0.0 { 1.0 / w } else { 0.0 };
+            let (mu, mus) = rc.mu(slot);
+            self.relax_rows.push(RelaxRow {
+                bodies,
+                jn: k.jn,
+                jt: k.jt,
+                sn: k.sn,
+                st: k.st,
+                inv_wnn: inv(w(&k.jn)),
+                inv_wtt: inv(w(&k.jt)),
+                mu,
+                mus,
+                slip: (vt.abs() > v_stick && mus.is_finite()).then_some(vt.signum()),
+                fnn: 0.0,
+                ft: 0.0,
+            });
+        }
+        let rate = |acc: &[[f64; 3]], r: &RelaxRow, j: &[[f64; 3]; 2], s: f64| {
+            let mut a = s;
+            for (b, body) in r.bodies.iter().enumerate() {
+                if let Some(b_) = body {
+                    a += dot3(j[b], acc[*b_]);
+                }
+            }
+            a
+        };
+        let push = |acc: &mut [[f64; 3]], r: &RelaxRow, j: &[[f64; 3]; 2], f: f64| {
+            for (b, body) in r.bodies.iter().enumerate() {
+                if let Some(b_) = body {
+                    let d = rc.minv(j[b]);
+                    for x in 0..3 {
+                        acc[*b_][x] += f * d[x];
+                    }
+                }
+            }
+        };
+        for _ in 0..sweeps {
+            for c in 0..self.relax_rows.len() {
+                let r = self.relax_rows[c];
+                let an = rate(&self.relax_acc, &r, &r.jn, r.sn);
+                let fnn = (r.fnn - an * r.inv_wnn).max(0.0);
+                push(&mut self.relax_acc, &r, &r.jn, fnn - r.fnn);
+                let ft = match r.slip {
+                    Some(dir) => -dir * r.mu * fnn,
+                    None if r.mus > 0.0 => {
+                        let at = rate(&self.relax_acc, &r, &r.jt, r.st);
+                        let free = r.ft - at * r.inv_wtt;
+                        let limit = if fnn > 0.0 { r.mus * fnn } else { 0.0 };
+                        free.clamp(-limit, limit)
+                    }
+                    None => 0.0,
+                };
+                push(&mut self.relax_acc, &r, &r.jt, ft - r.ft);
+                self.relax_rows[c].fnn = fnn;
+                self.relax_rows[c].ft = ft;
+            }
+        }
+        out.clear();
+        out.extend(self.relax_rows.iter().map(|r| [r.fnn, r.ft]));
     }
 }

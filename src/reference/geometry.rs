@@ -11,13 +11,122 @@
 
 use crate::domino::Block;
 
-/// Candidate slots per block for λ bottom points: slot p < λ is bottom point p
-/// on the ground (p = 0 the heel, p = λ−1 the front corner A); slot λ the front
-/// top corner B on the ground (a block lying on its face); slot λ+1 corner B of
-/// block i on the back face of block i+1 (the paper's B_i); slot λ+2 the heel of
-/// block i+1 on the front face of block i (used for the last pair only, see
-/// the engine).
+/// A corner of a block, body frame.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum Corner {
+    /// Back bottom (the heel).
+    BackBottom,
+    /// Front bottom (A, the pivot).
+    FrontBottom,
+    /// Front top (B, strikes the next block).
+    FrontTop,
+    /// Back top.
+    BackTop,
+}
+
+/// A face of a block; its outward normal in the body frame is −x, +x, −y, +y.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum Face {
+    /// −x, facing the block behind.
+    Back,
+    /// +x, facing the block ahead (the direction of the wave).
+    Front,
+    /// −y, standing on the ground.
+    Bottom,
+    /// +y, the top end.
+    Top,
+}
+
+/// Whose corner a pair slot of block i holds: block i's on a face of block
+/// i+1 (`Behind`), or block i+1's on a face of block i (`Ahead`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum Side {
+    /// The corner is block i's, the face block i+1's.
+    Behind,
+    /// The corner is block i+1's, the face block i's.
+    Ahead,
+}
+
+const CORNERS: [Corner; 4] = [
+    Corner::BackBottom,
+    Corner::FrontBottom,
+    Corner::FrontTop,
+    Corner::BackTop,
+];
+const FACES: [Face; 4] = [Face::Back, Face::Front, Face::Bottom, Face::Top];
+
+/// Every corner of either block of a pair against every face of the other:
+/// 2 × 4 × 4 contacts. The first two are the paper's B_i (block i's front
+/// top corner on the back face of block i+1) and the heel of block i+1 on
+/// the front face of block i; the other 30 follow in a fixed order.
+pub(crate) const PAIR_SLOTS: [(Side, Corner, Face); 32] = pair_table();
+
+const fn pair_table() -> [(Side, Corner, Face); 32] {
+    let mut t = [(Side::Behind, Corner::FrontTop, Face::Back); 32];
+    t[1] = (Side::Ahead, Corner::BackBottom, Face::Front);
+    let mut k = 2;
+    let mut s = 0;
+    while s < 2 {
+        let side = if s == 0 { Side::Behind } else { Side::Ahead };
+        let mut c = 0;
+        while c < 4 {
+            let mut f = 0;
+            while f < 4 {
+                let e = (side, CORNERS[c], FACES[f]);
+                let first = matches!(e, (Side::Behind, Corner::FrontTop, Face::Back));
+                let heel = matches!(e, (Side::Ahead, Corner::BackBottom, Face::Front));
+                if !first && !heel {
+                    t[k] = e;
+                    k += 1;
+                }
+                f += 1;
+            }
+            c += 1;
+        }
+        s += 1;
+    }
+    t
+}
+
+/// Candidate slots per block, for λ bottom points:
+///
+/// | slot | contact |
+/// | --- | --- |
+/// | p < λ | bottom point p on the ground (p = 0 the heel, p = λ−1 the front corner A) |
+/// | λ | the front top corner B on the ground (a block lying on its face) |
+/// | λ+1 | [`PAIR_SLOTS`]\[0\]: B of block i on the back face of block i+1 (the paper's B_i) |
+/// | λ+2 | [`PAIR_SLOTS`]\[1\]: the heel of block i+1 on the front face of block i (the engine uses it for the last pair, or everywhere with `heel_contacts`) |
+/// | λ+3 | the back top corner on the ground (a block lying on its back) |
+/// | λ+4 … λ+33 | [`PAIR_SLOTS`]\[2…31\]: every other corner of blocks i and i+1 on every face of the other |
 pub(crate) fn slots_per_block(lambda: usize) -> usize {
+    lambda + 4 + PAIR_SLOTS.len() - 2
+}
+
+/// The slot of block i that holds pair contact `k` of [`PAIR_SLOTS`].
+#[inline]
+pub(crate) fn pair_slot(k: usize, lambda: usize) -> usize {
+    if k < 2 {
+        lambda + 1 + k
+    } else {
+        lambda + 2 + k
+    }
+}
+
+/// The pair contact (index into [`PAIR_SLOTS`]) a slot holds, if it is one.
+#[inline]
+pub(crate) fn pair_of(slot: usize, lambda: usize) -> Option<usize> {
+    if slot == lambda + 1 || slot == lambda + 2 {
+        Some(slot - lambda - 1)
+    } else if slot >= lambda + 4 {
+        Some(slot - lambda - 2)
+    } else {
+        None
+    }
+}
+
+/// The slot of the back top corner on the ground.
+#[inline]
+pub(crate) fn back_top_slot(lambda: usize) -> usize {
     lambda + 3
 }
 
@@ -119,11 +228,47 @@ pub(crate) fn world_point(q: [f64; 3], local: [f64; 2]) -> [f64; 2] {
 
 /// Surface of a slot.
 pub(crate) fn surface(slot: usize, lambda: usize) -> Surface {
-    if slot <= lambda {
+    if slot <= lambda || slot == back_top_slot(lambda) {
         Surface::Ground
     } else {
         Surface::Block
     }
+}
+
+/// A corner's position in the body frame.
+#[inline]
+fn corner_local(block: &Block, c: Corner) -> [f64; 2] {
+    match c {
+        Corner::BackBottom => block.back_bottom(),
+        Corner::FrontBottom => block.front_bottom(),
+        Corner::FrontTop => block.front_top(),
+        Corner::BackTop => block.back_top(),
+    }
+}
+
+/// A face in the body frame: outward unit normal, the sign and size of its
+/// offset from the centre along that normal (half the thickness or half the
+/// height), and the half length along it.
+#[inline]
+fn face_local(block: &Block, f: Face) -> ([f64; 2], f64, f64) {
+    let (hd, hh) = (0.5 * block.thickness, 0.5 * block.height);
+    match f {
+        Face::Back => ([-1.0, 0.0], hd, hh),
+        Face::Front => ([1.0, 0.0], hd, hh),
+        Face::Bottom => ([0.0, -1.0], hh, hd),
+        Face::Top => ([0.0, 1.0], hh, hd),
+    }
+}
+
+/// Whether a corner at signed distance `gap` from a face (positive outside)
+/// and `along` its tangent from the face's middle belongs to that face: it
+/// projects onto the face, and it is outside, or inside the block with this
+/// face the nearest (the separating axis of least penetration; the other
+/// faces are at `2 depth + gap` and `half_length ∓ along`).
+#[inline]
+fn on_face(gap: f64, along: f64, depth: f64, half_length: f64) -> bool {
+    let lateral = half_length - along.abs();
+    lateral >= 0.0 && (gap >= 0.0 || (-gap <= depth && -gap <= lateral))
 }
 
 /// Geometry of candidate `slot` of block `i`; `q(j)` gives block j's
@@ -137,11 +282,13 @@ pub(crate) fn geom(
     slot: usize,
     q: impl Fn(usize) -> [f64; 3],
 ) -> Option<Geom> {
-    if slot <= lambda {
+    let Some(k) = pair_of(slot, lambda) else {
         let local = if slot < lambda {
             block.bottom_point(slot, lambda)
-        } else {
+        } else if slot == lambda {
             block.front_top()
+        } else {
+            block.back_top()
         };
         let p = world_point(q(i), local);
         return Some(Geom {
@@ -152,20 +299,20 @@ pub(crate) fn geom(
             face: None,
             valid: true,
         });
-    }
+    };
     if i + 1 >= n {
         return None;
     }
-    // (corner block, corner local, face block, face side ±1)
-    let (cb, local, fb, side) = if slot == lambda + 1 {
-        (i, block.front_top(), i + 1, -1.0)
-    } else {
-        (i + 1, block.back_bottom(), i, 1.0)
+    let (side, corner, face) = PAIR_SLOTS[k];
+    let (cb, fb) = match side {
+        Side::Behind => (i, i + 1),
+        Side::Ahead => (i + 1, i),
     };
-    let p = world_point(q(cb), local);
+    let p = world_point(q(cb), corner_local(block, corner));
     let qf = q(fb);
-    let nrm = rot(qf[2], [side, 0.0]);
-    let c = world_point(qf, [side * 0.5 * block.thickness, 0.0]);
+    let (nl, depth, half_length) = face_local(block, face);
+    let nrm = rot(qf[2], nl);
+    let c = world_point(qf, [nl[0] * depth, nl[1] * depth]);
     let r = [p[0] - c[0], p[1] - c[1]];
     let gap = dot(nrm, r);
     let along = dot(perp(nrm), r);
@@ -175,7 +322,7 @@ pub(crate) fn geom(
         normal: nrm,
         corner: cb,
         face: Some(fb),
-        valid: along.abs() <= 0.5 * block.height && gap > -0.5 * block.thickness,
+        valid: on_face(gap, along, depth, half_length),
     })
 }
 
@@ -217,6 +364,57 @@ pub(crate) fn kin(g: &Geom, q: impl Fn(usize) -> [f64; 3], v: impl Fn(usize) -> 
     }
 }
 
+/// The pair contacts k ≥ 2 of [`PAIR_SLOTS`] between blocks i and i+1 (at
+/// `qi`, `qj`) that can be within `margin` (m) of closing, given to `f`: each
+/// corner of either block taken into the other's frame, and, if it lies
+/// within `margin` of that block's outline, its contact with the nearest
+/// face (the one [`geom`] finds valid). A cheap filter: a pair of blocks
+/// has at most eight such contacts, usually none.
+pub(crate) fn near_pair_contacts(
+    block: &Block,
+    qi: [f64; 3],
+    qj: [f64; 3],
+    margin: f64,
+    mut f: impl FnMut(usize),
+) {
+    let (hd, hh) = (0.5 * block.thickness, 0.5 * block.height);
+    for (side, (qc, qf)) in [(Side::Behind, (qi, qj)), (Side::Ahead, (qj, qi))] {
+        let (s, c) = turn(qf[2]);
+        for corner in CORNERS {
+            let p = world_point(qc, corner_local(block, corner));
+            let r = [p[0] - qf[0], p[1] - qf[1]];
+            // the corner in the face block's frame
+            let (u, v) = (c * r[0] + s * r[1], -s * r[0] + c * r[1]);
+            let (ou, ov) = (u.abs() - hd, v.abs() - hh);
+            if ou > margin || ov > margin {
+                continue;
+            }
+            // outside: the face whose slab holds it; inside: the face of
+            // least depth (back/front at −ou, bottom/top at −ov); beyond a
+            // corner of the face block no face holds it ([`on_face`])
+            let x_face = match (ou > 0.0, ov > 0.0) {
+                (true, true) => continue,
+                (true, false) => true,
+                (false, true) => false,
+                (false, false) => ou >= ov,
+            };
+            let face = match (x_face, u < 0.0, v < 0.0) {
+                (true, true, _) => Face::Back,
+                (true, false, _) => Face::Front,
+                (false, _, true) => Face::Bottom,
+                (false, _, false) => Face::Top,
+            };
+            if let Some(k) = PAIR_SLOTS
+                .iter()
+                .skip(2)
+                .position(|e| *e == (side, corner, face))
+            {
+                f(k + 2);
+            }
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -242,7 +440,7 @@ mod tests {
             }
             (q, v)
         };
-        for slot in [0, 4, 8, 9, 10, 11] {
+        for slot in 0..slots_per_block(lambda) {
             let eval = |t: f64| {
                 let (q, v) = at(t);
                 let g = geom(&block, lambda, 2, 0, slot, |j| q[j]).unwrap();
@@ -305,5 +503,81 @@ mod tests {
         assert!((b.gap - (pitch - 0.01)).abs() < 1e-15 && b.valid);
         assert_eq!(b.normal, [-1.0, 0.0]);
         assert!(geom(&block, 9, 2, 1, 10, q).is_none());
+    }
+
+    /// Every corner–face contact of a pair, checked against a brute-force
+    /// search over random configurations: [`geom`] finds a corner on a face
+    /// exactly when the corner, taken into the face block's frame, projects
+    /// onto that face from outside or is inside with that face the nearest;
+    /// and [`near_pair_contacts`] hands on every contact k ≥ 2 within its
+    /// margin that [`geom`] finds valid.
+    #[test]
+    fn pair_contacts_match_a_brute_force_search() {
+        let block = Block::new(0.08, 0.012);
+        let (hd, hh) = (0.006, 0.04);
+        let lambda = 5;
+        let mut seed = 0x2545_f491_4f6c_dd1du64;
+        let mut unit = move || {
+            seed ^= seed << 13;
+            seed ^= seed >> 7;
+            seed ^= seed << 17;
+            (seed >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let margin = 1e-3 * block.height;
+        let mut seen_valid = 0;
+        for _ in 0..20_000 {
+            let qi = [0.0, 0.04, (unit() - 0.5) * 7.0];
+            let qj = [
+                (unit() - 0.5) * 0.12,
+                0.04 + (unit() - 0.5) * 0.1,
+                (unit() - 0.5) * 7.0,
+            ];
+            let q = |j: usize| if j == 0 { qi } else { qj };
+            let mut near = Vec::new();
+            near_pair_contacts(&block, qi, qj, margin, |k| near.push(k));
+            for k in 0..PAIR_SLOTS.len() {
+                let g = geom(&block, lambda, 2, 0, pair_slot(k, lambda), q).unwrap();
+                let (side, corner, face) = PAIR_SLOTS[k];
+                let (qc, qf) = match side {
+                    Side::Behind => (qi, qj),
+                    Side::Ahead => (qj, qi),
+                };
+                // brute force: the corner in the face block's frame
+                let p = world_point(qc, corner_local(&block, corner));
+                let (s, c) = qf[2].sin_cos();
+                let r = [p[0] - qf[0], p[1] - qf[1]];
+                let (u, v) = (c * r[0] + s * r[1], -s * r[0] + c * r[1]);
+                let depths = [u + hd, hd - u, v + hh, hh - v]; // back, front, bottom, top
+                let f = face as usize;
+                let inside = depths.iter().all(|d| *d > 0.0);
+                let projects = if f < 2 { v.abs() <= hh } else { u.abs() <= hd };
+                let nearest = depths.iter().all(|d| depths[f] <= *d);
+                let expected = if inside {
+                    nearest
+                } else {
+                    projects && depths[f] <= 0.0
+                };
+                // away from ties, where rounding decides
+                let tie = depths.iter().any(|d| d.abs() < 1e-12)
+                    || (0..4).any(|o| o != f && (depths[o] - depths[f]).abs() < 1e-12);
+                if !tie {
+                    assert_eq!(g.valid, expected, "k {k}: u {u} v {v} gap {}", g.gap);
+                    if g.valid {
+                        assert!((g.gap + depths[f]).abs() < 1e-12, "k {k}: gap {}", g.gap);
+                    }
+                }
+                if g.valid {
+                    seen_valid += 1;
+                }
+                if k >= 2 && g.valid && g.gap <= 0.5 * margin && !tie {
+                    assert!(
+                        near.contains(&k),
+                        "k {k} valid at gap {} not handed on",
+                        g.gap
+                    );
+                }
+            }
+        }
+        assert!(seen_valid > 1000, "{seen_valid}");
     }
 }

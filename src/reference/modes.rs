@@ -24,6 +24,22 @@ pub(crate) struct ModeTol {
     pub velocity: f64,
 }
 
+/// A hash of a mode assignment (FNV-1a over one code per candidate).
+fn state_key(state: &[Option<Mode>]) -> u64 {
+    let mut h = 0xcbf2_9ce4_8422_2325u64;
+    for m in state {
+        let code = match m {
+            None => 0u64,
+            Some(Mode::Frictionless) => 1,
+            Some(Mode::Stick) => 2,
+            Some(Mode::Slide(d)) if *d > 0.0 => 3,
+            Some(Mode::Slide(_)) => 4,
+        };
+        h = (h ^ code).wrapping_mul(0x0100_0000_01b3);
+    }
+    h
+}
+
 pub(crate) fn initial_mode(rc: &RowConst, slot: usize, vt: f64, tol: &ModeTol) -> Mode {
     let (mu, mus) = rc.mu(slot);
     if mus == f64::INFINITY {
@@ -39,10 +55,132 @@ pub(crate) fn initial_mode(rc: &RowConst, slot: usize, vt: f64, tol: &ModeTol) -
     }
 }
 
+/// The violations of a mode: the largest (its size, the candidate, the
+/// state that candidate should take) and the first 64 of them.
+struct Assessment {
+    worst: Option<(f64, usize, Option<Mode>)>,
+    all: usize,
+    changes: [(usize, Option<Mode>); 64],
+}
+
+/// Puts the pressing contacts of `state` into `out`, computes their forces
+/// and checks every candidate: a pressing contact must not pull nor stick
+/// beyond its cone, a free one must not be driven into its face. `None` if
+/// the contact system is singular.
+fn assess(
+    dyn_: &mut Dynamics,
+    rc: &RowConst,
+    view: &View,
+    candidates: &[Candidate],
+    state: &[Option<Mode>],
+    out: &mut Vec<Active>,
+    tol: &ModeTol,
+) -> Option<Assessment> {
+    out.clear();
+    for (c, m) in candidates.iter().zip(state.iter()) {
+        if let Some(mode) = m {
+            out.push(Active {
+                block: c.block,
+                slot: c.slot,
+                mode: *mode,
+            });
+        }
+    }
+    if !dyn_.forces(rc, view, out) {
+        return None;
+    }
+    let mut a = Assessment {
+        worst: None,
+        all: 0,
+        changes: [(0, None); 64],
+    };
+    let mut k = 0;
+    for (ci, (c, m)) in candidates.iter().zip(state.iter()).enumerate() {
+        let change = match m {
+            Some(mode) => {
+                let fnn = dyn_.fn_[k];
+                let ft = dyn_.ft[k];
+                k += 1;
+                let (mu, mus) = rc.mu(c.slot);
+                if fnn < -tol.force {
+                    Some((-fnn, None))
+                } else if *mode == Mode::Stick
+                    && rc.stick_excess(c.slot, ft, fnn.max(0.0)) > tol.force
+                {
+                    let next = if mu > 0.0 {
+                        Mode::Slide(-ft.signum())
+                    } else {
+                        Mode::Frictionless
+                    };
+                    Some((ft.abs() - mus * fnn, Some(next)))
+                } else {
+                    None
+                }
+            }
+            None => {
+                let g = rc.geom(view, c.block, c.slot).expect("slot exists");
+                let kk = rc.kin(view, &g);
+                let gdd = dyn_.gddot(view, &g, &kk);
+                if gdd < -tol.accel {
+                    let m = rc.p.block.mass;
+                    Some((-gdd * m, Some(initial_mode(rc, c.slot, c.vt, tol))))
+                } else {
+                    None
+                }
+            }
+        };
+        if let Some((size, next)) = change {
+            if a.worst.is_none_or(|w| size > w.0) {
+                a.worst = Some((size, ci, next));
+            }
+            if a.all < a.changes.len() {
+                a.changes[a.all] = (ci, next);
+            }
+            a.all += 1;
+        }
+    }
+    Some(a)
+}
+
+/// The modes candidate `c` may take when the search cycles: lifting off,
+/// and pressing — sticking or sliding either way while it barely slips,
+/// sliding along its slip when it slips. At most four.
+fn options(rc: &RowConst, c: &Candidate, tol: &ModeTol) -> ([Option<Mode>; 4], usize) {
+    let (mu, mus) = rc.mu(c.slot);
+    let mut o = [None; 4];
+    let mut n = 1;
+    let barely = c.vt.abs() <= tol.velocity || mus == f64::INFINITY;
+    let modes = [
+        (barely && mus > 0.0, Mode::Stick),
+        (barely && mu > 0.0 && mu.is_finite(), Mode::Slide(1.0)),
+        (barely && mu > 0.0 && mu.is_finite(), Mode::Slide(-1.0)),
+        (!barely && mu > 0.0, Mode::Slide(c.vt.signum())),
+    ];
+    for (allowed, m) in modes {
+        if allowed && n < o.len() {
+            o[n] = Some(m);
+            n += 1;
+        }
+    }
+    if n == 1 {
+        o[1] = Some(Mode::Frictionless);
+        n = 2;
+    }
+    (o, n)
+}
+
 /// Finds the mode; `out` receives the pressing contacts, in candidate order
 /// (which must be sorted by block). Returns false if no consistent mode was
-/// found within the iteration limit: the last one tried is kept, less the
-/// contacts whose normal force pulls (they lift off).
+/// found: the last one tried is kept, less the contacts whose normal force
+/// pulls (they lift off) and with the contacts that stick beyond their cone
+/// sliding.
+///
+/// The search changes the worst violation's contact one at a time (all of
+/// them in the first six rounds). It is deterministic, so a state it has
+/// tried before means it cycles — with friction, changing one contact can
+/// undo another (a corner that pulls when it presses and is driven into the
+/// ground when it does not): then every mode of the contacts in the cycle
+/// (up to four of them) is tried with the others as they are.
 pub(crate) fn select(
     dyn_: &mut Dynamics,
     rc: &RowConst,
@@ -58,93 +196,139 @@ pub(crate) fn select(
             .iter()
             .map(|c| Some(initial_mode(rc, c.slot, c.vt, tol))),
     );
+    // the states tried so far, hashed, and the candidates each round changed
+    let mut tried = [0u64; 200];
+    let mut changed = [(0u8, 0usize); 256];
+    let mut n_changed = 0;
+    let mut cycle: Option<usize> = None;
     for iter in 0..200 {
-        out.clear();
-        for (c, m) in candidates.iter().zip(state.iter()) {
-            if let Some(mode) = m {
-                out.push(Active {
-                    block: c.block,
-                    slot: c.slot,
-                    mode: *mode,
-                });
-            }
+        let key = state_key(state);
+        if let Some(first) = tried[..iter].iter().position(|k| *k == key) {
+            cycle = Some(first);
+            break;
         }
-        if !dyn_.forces(rc, view, out) {
+        tried[iter] = key;
+        let Some(a) = assess(dyn_, rc, view, candidates, state, out, tol) else {
             return false;
-        }
-        // violations: (size, candidate index, new state)
-        let mut worst: Option<(f64, usize, Option<Mode>)> = None;
-        let mut all: u32 = 0;
-        let mut changes: [(usize, Option<Mode>); 64] = [(0, None); 64];
-        let mut k = 0;
-        for (ci, (c, m)) in candidates.iter().zip(state.iter()).enumerate() {
-            let change = match m {
-                Some(mode) => {
-                    let fnn = dyn_.fn_[k];
-                    let ft = dyn_.ft[k];
-                    k += 1;
-                    let (mu, mus) = rc.mu(c.slot);
-                    if fnn < -tol.force {
-                        Some((-fnn, None))
-                    } else if *mode == Mode::Stick
-                        && rc.stick_excess(c.slot, ft, fnn.max(0.0)) > tol.force
-                    {
-                        let next = if mu > 0.0 {
-                            Mode::Slide(-ft.signum())
-                        } else {
-                            Mode::Frictionless
-                        };
-                        Some((ft.abs() - mus * fnn, Some(next)))
-                    } else {
-                        None
-                    }
-                }
-                None => {
-                    let g = rc.geom(view, c.block, c.slot).expect("slot exists");
-                    let kk = rc.kin(view, &g);
-                    let gdd = dyn_.gddot(view, &g, &kk);
-                    if gdd < -tol.accel {
-                        let m = rc.p.block.mass;
-                        Some((-gdd * m, Some(initial_mode(rc, c.slot, c.vt, tol))))
-                    } else {
-                        None
-                    }
-                }
-            };
-            if let Some((size, next)) = change {
-                if worst.is_none_or(|w| size > w.0) {
-                    worst = Some((size, ci, next));
-                }
-                if (all as usize) < changes.len() {
-                    changes[all as usize] = (ci, next);
-                }
-                all += 1;
-            }
-        }
-        let Some((_, ci, next)) = worst else {
+        };
+        let Some((_, ci, next)) = a.worst else {
             return true;
         };
-        if iter < 6 && (all as usize) <= changes.len() {
-            for &(ci, next) in &changes[..all as usize] {
+        let mut note = |ci: usize| {
+            if n_changed < changed.len() {
+                changed[n_changed] = (iter as u8, ci);
+                n_changed += 1;
+            }
+        };
+        if iter < 6 && a.all <= a.changes.len() {
+            for &(ci, next) in &a.changes[..a.all] {
                 state[ci] = next;
+                note(ci);
             }
         } else {
             state[ci] = next;
+            note(ci);
         }
     }
-    // No consistent mode (the search cycles, as frictional contact problems
-    // can). Never keep a contact that pulls: a pulling contact would call
-    // for a lift-off event at every step and stall the run. Let such
-    // contacts lift off (if they then close again, that is an event) and
-    // keep the rest of the last mode.
-    for _ in 0..out.len() {
-        let Some(worst) = (0..out.len())
-            .filter(|&k| dyn_.fn_[k] < -tol.force)
-            .min_by(|&a, &b| dyn_.fn_[a].total_cmp(&dyn_.fn_[b]))
-        else {
-            break;
+    if let Some(first) = cycle {
+        // the contacts changed inside the cycle
+        let mut set = [0usize; 4];
+        let mut size = 0;
+        let mut small = true;
+        for &(it, ci) in &changed[..n_changed] {
+            if (it as usize) < first || set[..size].contains(&ci) {
+                continue;
+            }
+            if size == set.len() {
+                small = false;
+                break;
+            }
+            set[size] = ci;
+            size += 1;
+        }
+        if small && size > 0 {
+            let opts: Vec<([Option<Mode>; 4], usize)> = set[..size]
+                .iter()
+                .map(|&ci| options(rc, &candidates[ci], tol))
+                .collect();
+            let combos: usize = opts.iter().map(|o| o.1).product();
+            for mut code in 0..combos {
+                for (&ci, (o, n)) in set[..size].iter().zip(&opts) {
+                    state[ci] = o[code % n];
+                    code /= n;
+                }
+                match assess(dyn_, rc, view, candidates, state, out, tol) {
+                    None => return false,
+                    Some(a) if a.worst.is_none() => return true,
+                    Some(_) => {}
+                }
+            }
+        }
+    }
+    // The relaxation's forces as a mode: pressing where F_n > 0, sticking
+    // inside the cone, sliding against F_t on its edge (along the slip
+    // where the contact slips).
+    let mut forces = Vec::with_capacity(candidates.len());
+    dyn_.relaxed_forces(
+        rc,
+        view,
+        candidates.iter().map(|c| (c.block, c.slot, c.vt)),
+        tol.velocity,
+        100,
+        &mut forces,
+    );
+    for (m, (c, [fnn, ft])) in state.iter_mut().zip(candidates.iter().zip(&forces)) {
+        let (mu, mus) = rc.mu(c.slot);
+        *m = if *fnn <= tol.force {
+            None
+        } else if mus == f64::INFINITY
+            || (c.vt.abs() <= tol.velocity && mus > 0.0 && ft.abs() < mus * fnn - tol.force)
+        {
+            Some(Mode::Stick)
+        } else if mu > 0.0 {
+            let dir = if c.vt.abs() > tol.velocity {
+                c.vt.signum()
+            } else {
+                -ft.signum()
+            };
+            Some(Mode::Slide(dir))
+        } else {
+            Some(Mode::Frictionless)
         };
-        out.remove(worst);
+    }
+    match assess(dyn_, rc, view, candidates, state, out, tol) {
+        None => return false,
+        Some(a) if a.worst.is_none() => return true,
+        Some(_) => {}
+    }
+    // No consistent mode (the search cycles, as frictional contact problems
+    // can). Never keep a contact that pulls, nor one that sticks beyond its
+    // cone: either would call for an event at every step and stall the run
+    // (a lift-off or stick → slip event fires as soon as the violation
+    // grows). Let the worst pulling contact lift off, else let the worst
+    // overloaded sticking contact slide, and repeat; if a contact that
+    // lifted off then closes again, that is an event of its own.
+    for _ in 0..2 * out.len() {
+        let pulling = (0..out.len())
+            .filter(|&k| dyn_.fn_[k] < -tol.force)
+            .min_by(|&a, &b| dyn_.fn_[a].total_cmp(&dyn_.fn_[b]));
+        if let Some(k) = pulling {
+            out.remove(k);
+        } else {
+            let excess = |k: usize| rc.stick_excess(out[k].slot, dyn_.ft[k], dyn_.fn_[k]);
+            let Some(k) = (0..out.len())
+                .filter(|&k| out[k].mode == Mode::Stick && excess(k) > tol.force)
+                .max_by(|&a, &b| excess(a).total_cmp(&excess(b)))
+            else {
+                break;
+            };
+            let (mu, _) = rc.mu(out[k].slot);
+            out[k].mode = if mu > 0.0 {
+                Mode::Slide(-dyn_.ft[k].signum())
+            } else {
+                Mode::Frictionless
+            };
+        }
         if !dyn_.forces(rc, view, out) {
             break;
         }

@@ -96,8 +96,14 @@ pub struct Settings {
     /// faster; set it to `impact.max_steps` to give the paper's law every step.
     pub held_retry_after: usize,
     /// Stop as soon as the last block is struck (the wave measures are then
-    /// complete); otherwise run until every block is at rest (default true).
+    /// complete), or [`Settings::after_last_hit`] later; otherwise run until
+    /// every block is at rest (default true).
     pub stop_at_last_hit: bool,
+    /// With `stop_at_last_hit`, run on this long (s) after the last block is
+    /// struck: the last blocks fall and the row settles into its pile
+    /// (default 0).
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub after_last_hit: f64,
     /// Stop after this much wall-clock time (s), keeping what was measured
     /// (the report's `stopped_early` is then true); default: no limit.
     pub wall_time_limit: Option<f64>,
@@ -127,6 +133,7 @@ impl Default for Settings {
             heel_contacts: false,
             held_retry_after: 20_000,
             stop_at_last_hit: true,
+            after_last_hit: 0.0,
             wall_time_limit: None,
             t_max: None,
             series_blocks: Vec::new(),
@@ -134,6 +141,10 @@ impl Default for Settings {
             snapshot_times: Vec::new(),
         }
     }
+}
+
+fn is_zero(x: &f64) -> bool {
+    *x == 0.0
 }
 
 impl Settings {

@@ -45,11 +45,11 @@ pub fn run_combo(c: &Combo, budget: f64) -> Observation {
 
 /// The reference engine with heel contacts (no overlap where blocks slide
 /// back, `Settings::heel_contacts`), observed through snapshots every 2 ms,
-/// up to the last block's hit: the wave its contact set models. (After it,
-/// in the pile of fallen blocks, a block whose top has passed the top of the
-/// block ahead would need that block's corner on its face, a contact the
-/// reference does not have: the sweep found blocks sliding through each
-/// other there, `docs/stress.md`.)
+/// up to the last block's hit: the wave its contact set models. (Its
+/// contacts are every corner of a block against every face of its two
+/// neighbours and the ground; after the last hit, in the pile of fallen
+/// blocks, a block can reach one that is not its neighbour, a pair the
+/// reference does not have, `docs/stress.md`.)
 fn reference(c: &Combo, budget: f64) -> Observation {
     let t_end = sim_time(c);
     let settings = Settings {

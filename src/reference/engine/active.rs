@@ -66,7 +66,7 @@ impl Engine {
                 let (rc, tol, eps, vapp) = (&self.rc, &self.tol, self.eps_gap, self.v_app);
                 let k = self.k_slots;
                 let is_active = &self.is_active;
-                self.for_each_slot(|i, slot| {
+                self.for_each_slot(&view, |i, slot| {
                     if is_active[i * k + slot] {
                         return;
                     }
@@ -135,7 +135,7 @@ impl Engine {
             let eps = self.eps_gap;
             let vt = self.v_tol;
             let vapp = self.v_app;
-            self.for_each_slot(|i, slot| {
+            self.for_each_slot(&view, |i, slot| {
                 let Some((_, k)) = closed_between_moving(rc, &view, i, slot, eps) else {
                     return;
                 };

@@ -45,7 +45,7 @@ impl Engine {
         let is_active = &self.is_active;
         let eps = self.eps_gap;
         let vapp = self.v_app;
-        self.for_each_slot(|i, slot| {
+        self.for_each_slot(&view, |i, slot| {
             if is_active[i * k + slot] || event {
                 return;
             }

@@ -74,7 +74,7 @@ impl Engine {
             buf.approaching.clear();
             let view = self.view();
             let (mut new_lo, mut new_hi) = (self.lo, self.hi);
-            self.for_each_slot(|i, slot| {
+            self.for_each_slot(&view, |i, slot| {
                 let Some(g) = self.rc.geom(&view, i, slot) else {
                     return;
                 };
@@ -115,13 +115,13 @@ impl Engine {
         buf.linked.clear();
         buf.linked.resize(nb, false);
         buf.closed.clear();
-        self.for_each_slot(|i, slot| {
+        self.for_each_slot(&view, |i, slot| {
             let Some(g) = self.rc.geom(&view, i, slot) else {
                 return;
             };
             if g.valid && g.gap <= self.eps_gap {
                 buf.closed.push((i, slot));
-                if slot > lambda && i >= self.lo && i + 1 < self.hi {
+                if surface(slot, lambda) == Surface::Block && i >= self.lo && i + 1 < self.hi {
                     buf.linked[i - self.lo] = true;
                 }
             }

@@ -53,19 +53,33 @@ impl Engine {
         self.ref_fn.clear();
         self.ref_stick.clear();
         self.ref_slide.clear();
+        // A condition already violated at the start (a mode the search could
+        // not make consistent, `modes::select`) is no event: it would fire at
+        // every step and stall the run. The next event runs the search again.
+        let (force, slip) = (self.tol.force, 0.5 * self.v_tol);
         for (c, a) in self.active.iter().enumerate() {
             let fnn = self.dynamics.fn_[c];
-            self.ref_fn.push(fnn.min(0.0));
-            self.ref_stick.push(
-                self.rc
-                    .stick_excess(a.slot, self.dynamics.ft[c], fnn)
-                    .max(0.0),
-            );
+            self.ref_fn.push(if fnn < -force {
+                f64::NEG_INFINITY
+            } else {
+                fnn.min(0.0)
+            });
+            let excess = self.rc.stick_excess(a.slot, self.dynamics.ft[c], fnn);
+            self.ref_stick.push(if excess > force {
+                f64::INFINITY
+            } else {
+                excess.max(0.0)
+            });
             let dir = match a.mode {
                 Mode::Slide(d) => d,
                 _ => 0.0,
             };
-            self.ref_slide.push((dir * self.dynamics.vt[c]).min(0.0));
+            let along = dir * self.dynamics.vt[c];
+            self.ref_slide.push(if along < -slip {
+                f64::NEG_INFINITY
+            } else {
+                along.min(0.0)
+            });
         }
         Ok(())
     }

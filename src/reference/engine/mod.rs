@@ -295,7 +295,9 @@ pub fn run_with_progress(
     let mut stopped_early = false;
     let mut hits_seen = 0;
     while e.lo < e.hi && e.t < t_max {
-        if settings.stop_at_last_hit && e.hit[row.n - 1].is_some() {
+        if settings.stop_at_last_hit
+            && e.hit[row.n - 1].is_some_and(|t| e.t >= t + settings.after_last_hit)
+        {
             break;
         }
         if let Some(limit) = settings.wall_time_limit {

@@ -3,6 +3,9 @@
 //! moving block, and freezing the blocks at rest at its back.
 
 use super::super::dynamics::View;
+use super::super::geometry::{
+    back_top_slot, near_pair_contacts, pair_slot, surface, Corner, Side, Surface, PAIR_SLOTS,
+};
 use super::{Engine, EngineError};
 
 impl Engine {
@@ -77,28 +80,48 @@ impl Engine {
         }
     }
 
-    /// Every (block, slot) pair that can involve a moving block, sorted by block.
-    pub(super) fn for_each_slot(&self, mut f: impl FnMut(usize, usize)) {
+    /// Every (block, slot) pair that can involve a moving block, sorted by
+    /// block, at the configuration of `view`: the ground contacts of the
+    /// moving blocks, B_i and (see below) the heel of every pair, and the
+    /// other corner–face contacts of a pair (`geometry::PAIR_SLOTS`) whose
+    /// corner lies within 10⁻³ h of the other block (the others cannot be
+    /// closed, so no caller needs them).
+    pub(super) fn for_each_slot(&self, view: &View, mut f: impl FnMut(usize, usize)) {
         let lambda = self.rc.p.lambda_points;
+        let n = self.row.n;
+        let block = &self.rc.p.block;
+        let margin = 1e-3 * block.height;
         let first = self.lo.saturating_sub(1);
-        for i in first..self.hi.min(self.row.n) {
+        for i in first..self.hi.min(n) {
             if i >= self.lo {
                 for slot in 0..=lambda {
                     f(i, slot);
                 }
+                f(i, back_top_slot(lambda));
             }
-            if i + 1 < self.row.n {
-                f(i, lambda + 1);
+            if i + 1 >= n {
+                continue;
             }
-            // The heel of block i+1 on the front face of block i: by default
-            // only for the last pair, where the last block lies on the ground.
-            // Inside the row the pair converges to face-to-face contact at the
+            f(i, pair_slot(0, lambda));
+            // The heel of block i+1 against block i: by default only for the
+            // last pair, where the last block lies on the ground. Inside the
+            // row the heel and B_i converge to face-to-face contact at the
             // rest angle, where the two corner contacts make the contact and
             // impact problems degenerate (the paper's model has only A_i and
             // B_i there); `Settings::heel_contacts` turns them on everywhere.
-            if i + 2 == self.row.n || (self.s.heel_contacts && i + 1 < self.row.n) {
-                f(i, lambda + 2);
+            // Without it the heel is left out against every face of block i,
+            // so that a heel sunk into its front face is not taken for a
+            // contact with another face.
+            let heel = i + 2 == n || self.s.heel_contacts;
+            if heel {
+                f(i, pair_slot(1, lambda));
             }
+            near_pair_contacts(block, view.q(i), view.q(i + 1), margin, |k| {
+                let (side, corner, _) = PAIR_SLOTS[k];
+                if heel || !(side == Side::Ahead && corner == Corner::BackBottom) {
+                    f(i, pair_slot(k, lambda));
+                }
+            });
         }
     }
 
@@ -139,7 +162,7 @@ impl Engine {
         self.new_active.clear();
         for a in &self.active {
             let moving = |j: usize| j >= lo && j < hi;
-            let keep = if a.slot <= lambda {
+            let keep = if surface(a.slot, lambda) == Surface::Ground {
                 moving(a.block)
             } else {
                 moving(a.block) && moving(a.block + 1)
