@@ -565,6 +565,41 @@ fn top_level_modules_use_only_the_layers_above_them() {
     );
 }
 
+/// Code behind a cargo feature uses only what that feature turns on: the
+/// Bevy plugin (`bevy`, which turns on `f32` only) never the f64 build, the
+/// stress sweep (both builds) or anything else behind `f64`, so a game's
+/// `default-features = false, features = ["bevy"]` compiles.
+#[test]
+fn the_bevy_plugin_uses_only_what_its_feature_turns_on() {
+    let root = src();
+    let krate = Crate::read(&root, &root.join("lib.rs"));
+    let mut wrong = Vec::new();
+    let mut read = 0;
+    for (path, f) in &krate.files {
+        if !path.starts_with("bevy") {
+            continue;
+        }
+        read += 1;
+        for name in [
+            "rapier::f64",
+            "rapier2d_f64",
+            "stress::",
+            "rayon::",
+            "par::",
+        ] {
+            if f.code.contains(name) {
+                wrong.push(format!("{} names {name}", path.display()));
+            }
+        }
+    }
+    assert!(read >= 5, "src/bevy/ not read");
+    assert!(
+        wrong.is_empty(),
+        "the Bevy plugin needs more than `f32`:\n{}",
+        wrong.join("\n")
+    );
+}
+
 #[test]
 fn the_reader_sees_a_cycle_it_is_given() {
     // two throw-away files that import each other, read like src/

@@ -29,6 +29,7 @@ pub use row::{expand_row, row_params, NO_SLIP_FRICTION};
 pub use run::{run_row, run_scene};
 #[cfg(feature = "scene-files")]
 pub use setup::load_scene;
+#[cfg(any(feature = "f32", feature = "f64"))]
 pub(crate) use setup::pair_material;
 pub use setup::{
     row_scene, topple_settings, BodyState, Engine, RunOptions, SceneOutput, TimedImpact,
