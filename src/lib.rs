@@ -19,9 +19,14 @@
 //! | [`stress`] | the stress sweep: seeded combinations over every engine, invariants checked independently |
 //!
 //! Data flows down the table: a module uses the ones above it, never one below
-//! (the Bevy plugin, [`bevy`](mod@bevy) with the `bevy` feature, sits on all of
+//! (the Bevy plugin, `topple::bevy` with the `bevy` feature, sits on all of
 //! them; `tests/module_graph.rs` checks the order and that no files import
 //! each other in a cycle).
+//!
+//! Cargo features: `f64` and `f32` compile the two Rapier builds
+//! (`rapier::f64`, `rapier::f32`), `parallel` runs the sweeps on rayon,
+//! `bevy` adds the Bevy plugin with the f32 build only, `cli` the `topple`
+//! command; the defaults are `cli`, `f32`, `f64` and `parallel`.
 //! The Rapier crates topple is built against are re-exported, so a user does
 //! not have to spell their pre-release versions: [`rapier2d_f64`] and
 //! [`rapier2d`].
