@@ -147,7 +147,10 @@ fn expand_use(tree: &str) -> Vec<Vec<String>> {
 
 /// The `use` declarations of a file: (is `pub`, the expanded paths), and
 /// the code with them removed.
-fn use_decls(code: &str) -> (Vec<(bool, Vec<Vec<String>>)>, String) {
+/// A `use` declaration: whether it is a re-export, and its expanded paths.
+type UseDecl = (bool, Vec<Vec<String>>);
+
+fn use_decls(code: &str) -> (Vec<UseDecl>, String) {
     let mut decls = Vec::new();
     let mut rest = String::new();
     let mut i = 0;
@@ -314,7 +317,7 @@ impl Crate {
         }
         // the deepest module on the path
         let mut k = 0;
-        while k < path.len() && self.modules.contains_key(&path[..=k].to_vec()) {
+        while k < path.len() && self.modules.contains_key(&path[..=k]) {
             k += 1;
         }
         if k == 0 {
@@ -331,7 +334,7 @@ impl Crate {
                 root.file.clone()
             });
         }
-        let module = &self.modules[&path[..k].to_vec()];
+        let module = &self.modules[&path[..k]];
         if k < path.len() {
             let name = &path[k];
             if let Some(target) = module.reexports.get(name) {
