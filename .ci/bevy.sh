@@ -19,6 +19,9 @@ if [ ${#missing[@]} -gt 0 ]; then
 fi
 
 cargo build --locked --release --features bevy --examples
+# where cargo put them (CARGO_TARGET_DIR honoured); .ci/run exports it
+TARGET_DIR=${TARGET_DIR:-$(.ci/target_dir.sh)}
+ex="$TARGET_DIR/release/examples"
 
 out=$(mktemp -d)
 export XDG_RUNTIME_DIR="$out"
@@ -26,26 +29,26 @@ icd=/usr/share/vulkan/icd.d/lvp_icd.x86_64.json
 [ -f "$icd" ] && export VK_ICD_FILENAMES="$icd"
 
 echo "headless_row (topple and native, ideal Domino T, s/h 0.45, 1/60 s)"
-./target/release/examples/headless_row --preset t --ideal --n 60
-./target/release/examples/headless_row --preset t --ideal --n 60 --native
+"$ex"/headless_row --preset t --ideal --n 60
+"$ex"/headless_row --preset t --ideal --n 60 --native
 
 echo "dominoes --screenshot under Xvfb"
 timeout 300 xvfb-run -a -s "-screen 0 1280x720x24" \
-    ./target/release/examples/dominoes --screenshot "$out/dominoes.png" --frames 50
+    "$ex"/dominoes --screenshot "$out/dominoes.png" --frames 50
 python3 .ci/check_screenshot.py "$out/dominoes.png"
 
 echo "cradle --screenshot under Xvfb"
 timeout 300 xvfb-run -a -s "-screen 0 1280x720x24" \
-    ./target/release/examples/cradle --screenshot "$out/cradle.png" --frames 120
+    "$ex"/cradle --screenshot "$out/cradle.png" --frames 120
 test -s "$out/cradle.png"
 
 echo "domino_show --screenshot under Xvfb (6 fronts in pixel units)"
 timeout 300 xvfb-run -a -s "-screen 0 1280x720x24" \
-    ./target/release/examples/domino_show --screenshot "$out/domino_show.png" --frames 120
+    "$ex"/domino_show --screenshot "$out/domino_show.png" --frames 120
 python3 .ci/check_screenshot.py "$out/domino_show.png"
 
 echo "pile --screenshot under Xvfb"
 timeout 300 xvfb-run -a -s "-screen 0 1280x720x24" \
-    ./target/release/examples/pile --screenshot "$out/pile.png" --frames 240
+    "$ex"/pile --screenshot "$out/pile.png" --frames 240
 test -s "$out/pile.png"
 rm -rf "$out"

@@ -135,7 +135,7 @@ fn pour_more(mut commands: Commands, mut pour: ResMut<Pour>, contexts: Res<Conte
         pour.started = true;
         pour.frame = 0;
     }
-    if pour.frame % 4 == 0 && pour.poured < pour.bodies {
+    if pour.frame.is_multiple_of(4) && pour.poured < pour.bodies {
         let k = pour.poured;
         let pour = &mut *pour;
         pour_body(&mut commands, target, k, &mut pour.rng);

@@ -84,12 +84,13 @@ pub struct RapierRow {
 }
 
 impl RapierRow {
-    /// `engine` on the f64 build at time step `dt` (s), default settings
-    /// otherwise, stopping after 600 s of simulated time.
+    /// `engine` on the f64 build (the f32 one when only it is compiled) at
+    /// time step `dt` (s), default settings otherwise, stopping after 600 s
+    /// of simulated time.
     pub fn new(engine: Engine, dt: f64) -> Self {
         RapierRow {
             engine,
-            precision: Precision::F64,
+            precision: Precision::default(),
             solver: SolverSpec {
                 dt,
                 ..SolverSpec::default()

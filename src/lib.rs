@@ -12,13 +12,21 @@
 //! | [`coupling`] | engine-agnostic: materials, λ-point patches, impact groups, the fallback policy |
 //! | [`domino`] | block geometry, Table 1 presets, row builder, wave-speed measures |
 //! | [`theory`] | cooperative, extended and single-collision models of the wave |
-//! | [`reference`](mod@reference) | the paper's reduced-coordinate domino model (the accuracy oracle) |
-//! | [`engines`] | one interface ([`engines::RowEngine`]) for every engine that runs a domino row |
-//! | [`rapier`] | the plugin for Rapier, one source for `rapier2d-f64` and `rapier2d` (f32) |
-//! | [`stress`] | the stress sweep: seeded combinations over every engine, invariants checked independently |
 //! | [`validate`] | input checks at the entry points: field, value and allowed range on one line |
+//! | [`reference`](mod@reference) | the paper's reduced-coordinate domino model (the accuracy oracle) |
+//! | [`rapier`] | the plugin for Rapier, one source for `rapier2d-f64` and `rapier2d` (f32) |
+//! | [`engines`] | one interface ([`engines::RowEngine`]) for every engine that runs a domino row |
+//! | [`stress`] | the stress sweep: seeded combinations over every engine, invariants checked independently |
 //!
-//! Data flows down the table: a module uses the ones above it, never one below.
+//! Data flows down the table: a module uses the ones above it, never one below
+//! (the Bevy plugin, `topple::bevy` with the `bevy` feature, sits on all of
+//! them; `tests/module_graph.rs` checks the order and that no files import
+//! each other in a cycle).
+//!
+//! Cargo features: `f64` and `f32` compile the two Rapier builds
+//! (`rapier::f64`, `rapier::f32`), `parallel` runs the sweeps on rayon,
+//! `bevy` adds the Bevy plugin with the f32 build only, `cli` the `topple`
+//! command; the defaults are `cli`, `f32`, `f64` and `parallel`.
 //! The Rapier crates topple is built against are re-exported, so a user does
 //! not have to spell their pre-release versions: [`rapier2d_f64`] and
 //! [`rapier2d`].
@@ -26,6 +34,8 @@
 // `rapier::f64` and `rapier::f32` compile the same adapter files (one source,
 // two precisions, as Rapier builds rapier2d and rapier2d-f64).
 #![allow(clippy::duplicate_mod)]
+#![warn(missing_docs)]
+#![cfg_attr(docsrs, feature(doc_cfg))]
 
 pub mod atomic;
 #[cfg(feature = "bevy")]
@@ -34,13 +44,17 @@ pub mod coupling;
 pub mod domino;
 pub mod engines;
 pub mod impact;
+mod par;
 pub mod rapier;
 pub mod reference;
+#[cfg(all(feature = "f32", feature = "f64"))]
 pub mod stress;
 pub mod theory;
 pub mod validate;
 
+#[cfg(feature = "f32")]
 pub use rapier2d;
+#[cfg(feature = "f64")]
 pub use rapier2d_f64;
 
 // The README's code blocks compile and run as doctests, so they cannot go stale.

@@ -153,10 +153,11 @@ impl<'a> SceneSpawn<'a> {
     /// Spawns the scene: the ground, the bodies (a row's blocks asleep but
     /// the first, as a row at rest is), a [`DominoRowState`] for a row, and
     /// with topple its pair rules in [`ToppleConfig`]. The scene is checked
-    /// first (`topple::validate::scene`); a bad one is refused with its
+    /// first (`topple::rapier::scene::check_scene`); a bad one is refused with its
     /// message and nothing is spawned.
     pub fn spawn(&self, commands: &mut Commands) -> SceneResult<SpawnedScene> {
-        crate::validate::scene(self.scene).map_err(|e| SceneError::invalid(e.to_string()))?;
+        crate::rapier::scene::check_scene(self.scene)
+            .map_err(|e| SceneError::invalid(e.to_string()))?;
         if !(self.scale.is_finite() && self.scale > 0.0) {
             return Err(SceneError::invalid(format!(
                 "scale = {}: must be > 0 and finite",

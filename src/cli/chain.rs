@@ -10,6 +10,7 @@ use topple::engines::{RapierRow, RowEngine};
 use topple::impact::StepControl;
 use topple::rapier::scene::{Engine, SolverSpec};
 use topple::reference::{snapshot_png, snapshot_svg, Integrator, Settings};
+use topple::theory::{Geometry, Model, Outcome};
 use topple::validate::{self, EngineKind, InputError, Naming, RunBudget};
 
 /// Block type of Table 1.
@@ -481,10 +482,82 @@ fn print_report(r: &topple::domino::ChainReport, spacing_ratio: f64, row: &RowSp
         ),
         None => println!("natural speed: the wave stopped before block 8"),
     }
+    println!("{}", theory_line(&row.params, spacing_ratio));
     if let Some(e) = r.energy {
         println!(
             "energy (J): initial {:.6e}, kinetic {:.6e}, potential {:.6e}, impacts {:.6e}, friction {:.6e}, projection {:.3e}, frozen {:.3e}, residual {:.3e}",
             e.initial, e.kinetic, e.potential, e.impacts, e.friction, e.projection, e.frozen, e.residual
         );
+    }
+}
+
+/// The theory model whose assumptions the row's material meets
+/// (docs/theory.md): the group models need collisions that keep the blocks
+/// leaning on each other (e1 = 0), the cooperative one frictionless contacts
+/// between blocks (μ1 = 0), the extended one adds μ1; with e1 > 0 only the
+/// single collision model (μ1, e1) holds.
+pub fn theory_model(p: &RowParams) -> (Model, &'static str) {
+    if p.e1 == 0.0 && p.mu1 == 0.0 {
+        (Model::Cooperative, "mu1 = 0, e1 = 0")
+    } else if p.e1 == 0.0 {
+        (Model::Extended { mu: p.mu1 }, "e1 = 0, mu1 > 0")
+    } else {
+        (
+            Model::Single { mu: p.mu1, e: p.e1 },
+            "e1 > 0: the group models assume e1 = 0",
+        )
+    }
+}
+
+/// The line of the text report that gives the theory's natural speed v̂_na
+/// for the row's d/h and s/h, from the model [`theory_model`] picks.
+fn theory_line(p: &RowParams, spacing_ratio: f64) -> String {
+    let (model, why) = theory_model(p);
+    let outcome = Geometry::new(p.block.thickness / p.block.height, spacing_ratio)
+        .and_then(|g| topple::theory::solve(&model, &g));
+    match outcome {
+        Ok(Outcome::Wave(w)) => format!(
+            "theory: v̂_na = {:.4} ({} model, {why})",
+            w.natural_speed,
+            model.name()
+        ),
+        Ok(Outcome::NoWave(reason)) => {
+            format!("theory: no wave ({} model, {why}): {reason}", model.name())
+        }
+        Err(e) => format!("theory: not solved ({} model, {why}): {e}", model.name()),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn theory_picks_the_model_whose_assumptions_hold() {
+        let ideal = Preset::T.params().ideal();
+        assert_eq!(theory_model(&ideal).0, Model::Cooperative);
+        let mut rough = ideal;
+        rough.mu1 = 0.2;
+        assert_eq!(theory_model(&rough).0, Model::Extended { mu: 0.2 });
+        rough.e1 = 0.6;
+        assert_eq!(theory_model(&rough).0, Model::Single { mu: 0.2, e: 0.6 });
+    }
+
+    #[test]
+    fn theory_line_is_the_cooperative_speed_of_van_leeuwens_example() {
+        // docs/theory.md: h = 48 mm, d = 7.5 mm, λ = 16 mm, g = 9.8 m/s²
+        // give 1.380 m/s in the cooperative model
+        let mut p = Preset::T.params().ideal();
+        p.block.height = 0.048;
+        p.block.thickness = 0.0075;
+        let v = 1.380 / (9.8f64 * 0.048).sqrt();
+        let line = theory_line(&p, (0.016 - 0.0075) / 0.048);
+        let printed: f64 = line["theory: v̂_na = ".len()..][..6].parse().unwrap();
+        assert!(
+            (printed - v).abs() < 0.005 / (9.8f64 * 0.048).sqrt() + 1e-4,
+            "{line}"
+        );
+        assert!(line.contains("cooperative model"), "{line}");
+        assert!(theory_line(&p, 1.2).contains("no wave"));
     }
 }

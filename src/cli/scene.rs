@@ -34,7 +34,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     let text = std::fs::read_to_string(&args.file)
         .with_context(|| format!("reading {}", args.file.display()))?;
     let scene: Scene = topple::validate::parse_toml(&text, &args.file.display().to_string())?;
-    topple::validate::scene(&scene)?;
+    topple::rapier::scene::check_scene(&scene)?;
     let options = RunOptions {
         stop_after_last_hit: args.until_last_hit,
         dump_fallback_impact: args.dump_fallback_impact.clone(),

@@ -59,11 +59,13 @@
 //!
 //! | check | f64 | f32 |
 //! | --- | --- | --- |
-//! | impact inside a step vs the closed form (`tests/rapier_game_rate.rs`) | 10⁻⁸ m/s | 2·10⁻⁵ m/s |
+//! | impact inside a step vs the closed form (`tests/rapier/game_rate.rs`) | 10⁻⁸ m/s | 2·10⁻⁵ m/s |
 //! | box cradle at 1/60 s, momentum and energy | 10⁻⁶ relative | 10⁻⁶ relative |
 //! | ideal Domino T row at 1/60 s, v̂_na | within 6 % of the reference | within 1 % of f64 |
 
+#[cfg(feature = "f32")]
 pub mod f32;
+#[cfg(feature = "f64")]
 pub mod f64;
 pub mod scene;
 
@@ -101,25 +103,48 @@ pub enum HookMode {
     Native,
 }
 
-/// Which Rapier build runs a world.
+/// Which Rapier build runs a world. Each is compiled only with its cargo
+/// feature (`f32`, `f64`); running on one that is not compiled gives
+/// [`scene::SceneError::NotBuilt`].
 ///
 /// ```
 /// use topple::rapier::Precision;
+/// // f64 when it is compiled (the default features compile both)
 /// assert_eq!(Precision::default(), Precision::F64);
+/// assert!(Precision::F32.is_built() && Precision::F64.is_built());
 /// assert_eq!(Precision::F32.name(), "f32");
 /// ```
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 #[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
 #[serde(rename_all = "lowercase")]
 pub enum Precision {
     /// `rapier2d` (f32), the build `bevy_rapier2d` uses.
     F32,
     /// `rapier2d-f64`.
-    #[default]
     F64,
 }
 
+impl Default for Precision {
+    /// [`Precision::F64`] when it is compiled, else [`Precision::F32`].
+    fn default() -> Self {
+        if cfg!(feature = "f64") || !cfg!(feature = "f32") {
+            Precision::F64
+        } else {
+            Precision::F32
+        }
+    }
+}
+
 impl Precision {
+    /// Whether this build of topple compiles this Rapier build (cargo
+    /// features `f32` and `f64`).
+    pub fn is_built(self) -> bool {
+        match self {
+            Precision::F32 => cfg!(feature = "f32"),
+            Precision::F64 => cfg!(feature = "f64"),
+        }
+    }
+
     /// The name used on the command line and in JSON.
     pub fn name(self) -> &'static str {
         match self {

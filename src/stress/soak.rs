@@ -87,7 +87,7 @@ pub fn soak(scene: &Scene, spec: &SoakSpec, memory: impl Fn() -> Option<u64> + S
         let mut samples = Vec::new();
         let mut cycles = 1;
         let mut reset = |frame: usize, _energy: f64| {
-            let end = (frame + 1) % per_cycle == 0;
+            let end = (frame + 1).is_multiple_of(per_cycle);
             if end {
                 if sample {
                     if let Some(m) = memory() {
@@ -107,7 +107,7 @@ pub fn soak(scene: &Scene, spec: &SoakSpec, memory: impl Fn() -> Option<u64> + S
         let seen = run_with(scene, Engine::Rapier, spec.precision, &mut hooks);
         (seen, samples, cycles)
     };
-    let ((seen, memory, cycles), (again, _, _)) = rayon::join(|| one(true), || one(false));
+    let ((seen, memory, cycles), (again, _, _)) = crate::par::join(|| one(true), || one(false));
     SoakReport {
         repeat_hash: (!again.over_budget && again.error.is_none()).then_some(again.hash),
         seen,

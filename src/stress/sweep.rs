@@ -3,7 +3,7 @@
 
 use std::collections::BTreeMap;
 
-use rayon::prelude::*;
+use crate::par::prelude::*;
 
 use super::combo::{draw, reproduce, Combo, StressEngine};
 use super::engines::run_combo;

@@ -1,7 +1,7 @@
 //! A sweep over the spacing s/h for several models, and its CSV table.
 
 use super::{solve, Geometry, Model, Outcome, TheoryError};
-use rayon::prelude::*;
+use crate::par::prelude::*;
 use std::io::Write;
 
 /// One spacing of a sweep: the outcome of each model, in the order given.

@@ -1,14 +1,16 @@
 //! Input checks at the entry points (CLI flags, scene files, impact JSON):
 //! every bad value is refused before any work starts, with one line naming
 //! the field, the value and the allowed range. The limits are documented in
-//! `docs/input-limits.md`.
+//! `docs/input-limits.md`. A scene's checks, which need the scene format,
+//! live beside it: [`crate::rapier::scene::check_scene`].
 //!
 //! | item | file | what it checks |
 //! | --- | --- | --- |
 //! | [`InputError`], [`check_range`], [`check_count`] | `mod.rs` | the error and the range checks every other file uses |
 //! | [`row()`], [`RunBudget`], [`Naming`] | `row.rs` | a domino row, the engine's time step, tolerance and budget |
 //! | [`memory_estimate`], [`check_memory`] | `memory.rs` | what a row of n blocks needs against what the machine has |
-//! | [`scene()`], [`parse_toml`], [`SyntaxError`] | `scene.rs` | a TOML scene: ranges, degenerate shapes, overlapping bodies; one-line parse errors |
+//! | [`parse_toml`], [`SyntaxError`] | `syntax.rs` | one-line parse errors of TOML and JSON input |
+//! | `Placed`, `overlap`, `box_overlap` | `overlap.rs` | overlap depth of balls and boxes (the scene check, the stress sweep) |
 //! | [`impact()`], [`impact_stepping`] | `impact.rs` | the magnitudes of an impact given as JSON; the reference engine's impulse stepping flags |
 //!
 //! ```
@@ -20,16 +22,18 @@
 
 mod impact;
 mod memory;
+pub(crate) mod overlap;
 pub mod row;
-mod scene;
+mod syntax;
 
 pub use impact::{impact, impact_stepping};
 pub use memory::{available_memory, check_memory, memory_estimate, EngineKind};
+#[cfg(all(feature = "f32", feature = "f64"))]
+pub(crate) use overlap::box_overlap;
 pub use row::{row, Naming, RunBudget};
-pub(crate) use scene::box_overlap;
 #[cfg(feature = "scene-files")]
-pub use scene::parse_toml;
-pub use scene::{scene, SyntaxError};
+pub use syntax::parse_toml;
+pub use syntax::SyntaxError;
 
 /// A value outside its allowed range: the field, the value as given and the
 /// range, printed on one line. The CLI exits with status 2 on it.

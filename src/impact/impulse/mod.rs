@@ -520,7 +520,7 @@ impl ImpulseStepper {
                     if out.steps >= max_steps {
                         return Err(ImpactError::StepLimit { steps: out.steps });
                     }
-                    if out.steps % 4096 == 0 && !self.finite() {
+                    if out.steps.is_multiple_of(4096) && !self.finite() {
                         return Err(ImpactError::NonFinite { steps: out.steps });
                     }
                 }
@@ -575,7 +575,7 @@ impl ImpulseStepper {
                 continue;
             }
             out.steps += 1;
-            if out.steps % 4096 == 0 && !self.finite() {
+            if out.steps.is_multiple_of(4096) && !self.finite() {
                 return Err(ImpactError::NonFinite { steps: out.steps });
             }
             let grow = if error > 0.0 {

@@ -32,6 +32,10 @@ pub enum SceneError {
         /// `FILE:LINE:COLUMN: what is wrong`, on one line.
         message: String,
     },
+    /// The run asks for a Rapier build that this build of topple does not
+    /// compile (cargo features `f32` and `f64`).
+    #[error("precision {}: topple was built without its cargo feature `{}`", .0.name(), .0.name())]
+    NotBuilt(crate::rapier::Precision),
 }
 
 impl SceneError {

@@ -8,23 +8,29 @@
 //! | [`Scene`] and its parts | `format.rs` | the TOML format (serde) |
 //! | [`SceneError`] | `error.rs` | why a scene could not be loaded, built or run |
 //! | [`expand_row`], [`row_params`] | `row.rs` | the `[row]` generator over [`crate::domino`]'s presets and ground models |
-//! | [`Engine`], [`run_scene`], [`run_row`], [`SceneOutput`] | `setup.rs` | build-independent front: settings, materials, output, dispatch to [`crate::rapier::f64`] or [`crate::rapier::f32`] |
+//! | [`Engine`], [`SceneOutput`], [`row_scene`] | `setup.rs` | build-independent front: settings, materials, output |
+//! | [`run_scene`], [`run_row`] | `run.rs` | dispatch to the `f64` or `f32` build (each behind its cargo feature) |
+//! | [`check_scene`] | `check.rs` | a parsed scene's ranges, degenerate shapes, overlapping bodies |
 
+mod check;
 mod error;
 mod format;
 mod row;
+mod run;
 mod setup;
 
+pub use check::check_scene;
 pub use error::{SceneError, SceneResult};
 pub use format::{
     BodySpec, GroundSpec, MaterialSpec, PairLaw, PairSpec, RowOverrides, RowSpec, Scene, ShapeKind,
     SolverSpec,
 };
 pub use row::{expand_row, row_params, NO_SLIP_FRICTION};
+pub use run::{run_row, run_scene};
 #[cfg(feature = "scene-files")]
 pub use setup::load_scene;
+#[cfg(any(feature = "f32", feature = "f64"))]
 pub(crate) use setup::pair_material;
 pub use setup::{
-    row_scene, run_row, run_scene, topple_settings, BodyState, Engine, RunOptions, SceneOutput,
-    TimedImpact,
+    row_scene, topple_settings, BodyState, Engine, RunOptions, SceneOutput, TimedImpact,
 };

@@ -1,7 +1,6 @@
 //! What a scene run needs that does not depend on the Rapier build: the
 //! engine choice, the settings and materials built from a scene, the output.
 
-use super::error::SceneResult;
 use crate::coupling::{FallbackPolicy, ImpactReport, PairMaterial, PatchRule, ToppleSettings};
 use crate::impact::{ContactMaterial, ImpactSettings};
 use crate::rapier::{Precision, ToppleStats};
@@ -36,6 +35,9 @@ impl Engine {
     }
 }
 
+/// The material of a pair rule (the adapters use it; without a Rapier build
+/// nothing does).
+#[cfg_attr(not(any(feature = "f32", feature = "f64")), allow(dead_code))]
 pub(crate) fn pair_material(l: &PairLaw) -> PairMaterial {
     if l.no_slip {
         return PairMaterial {
@@ -169,52 +171,9 @@ pub struct RunOptions {
     pub dump_fallback_impact: Option<std::path::PathBuf>,
 }
 
-/// Runs a scene with an engine on the Rapier build of `precision`.
-///
-/// ```
-/// use topple::rapier::scene::{run_scene, Engine, RunOptions, Scene};
-/// use topple::rapier::Precision;
-/// let scene: Scene = toml::from_str(r#"
-///     duration = 0.01
-///     gravity = [0.0, 0.0]
-///     [[materials]]
-///     name = "steel"
-///     stiffness = 1e10
-///     [[bodies]]
-///     shape = "ball"
-///     radius = 0.05
-///     position = [0.0, 0.0]
-///     velocity = [1.0, 0.0]
-///     mass = 1.0
-///     material = "steel"
-///     [[bodies]]
-///     shape = "ball"
-///     radius = 0.05
-///     position = [0.1, 0.0]
-///     mass = 1.0
-///     material = "steel"
-/// "#).unwrap();
-/// for precision in [Precision::F64, Precision::F32] {
-///     let out = run_scene(&scene, Engine::Rapier, precision, RunOptions::default()).unwrap();
-///     assert_eq!(out.impacts.len(), 1);
-///     assert!((out.bodies[1].velocity[0] - 1.0).abs() < 1e-3);
-/// }
-/// ```
-pub fn run_scene(
-    scene: &Scene,
-    engine: Engine,
-    precision: Precision,
-    options: RunOptions,
-) -> SceneResult<SceneOutput> {
-    match precision {
-        Precision::F64 => crate::rapier::f64::run_scene(scene, engine, options),
-        Precision::F32 => crate::rapier::f32::run_scene(scene, engine, options),
-    }
-}
-
 /// Reads and parses a scene file.
 #[cfg(feature = "scene-files")]
-pub fn load_scene(path: &std::path::Path) -> SceneResult<Scene> {
+pub fn load_scene(path: &std::path::Path) -> super::SceneResult<Scene> {
     let text = std::fs::read_to_string(path).map_err(|source| super::SceneError::Io {
         path: path.into(),
         source,
@@ -268,37 +227,5 @@ pub fn row_scene(row: &DominoRow, solver: SolverSpec, max_time: f64) -> Scene {
                 impact_friction_factor: Some(p.impact_friction_factor),
             },
         }),
-    }
-}
-
-/// Runs a domino row of [`crate::domino`] through Rapier (topple or native,
-/// either build) until its last block is hit, nothing was hit for 2 s, or
-/// `max_time` (s) passed; `progress` gets the number of blocks hit so far.
-///
-/// ```
-/// use topple::domino::{Preset, RowSpec};
-/// use topple::rapier::scene::{run_row, Engine, SolverSpec};
-/// use topple::rapier::Precision;
-/// let p = Preset::T.params().ideal();
-/// let row = RowSpec::new(p, 0.45 * p.block.height, 4, 1.0);
-/// let solver = SolverSpec { dt: 1.0 / 240.0, ..SolverSpec::default() };
-/// let r = run_row(&row, Engine::Rapier, Precision::F64, solver, 2.0, |_| {}).unwrap();
-/// assert_eq!(r.hit_times.len(), 4); // the wave reached the last block
-/// ```
-pub fn run_row(
-    row: &DominoRow,
-    engine: Engine,
-    precision: Precision,
-    solver: SolverSpec,
-    max_time: f64,
-    progress: impl FnMut(usize),
-) -> SceneResult<ChainReport> {
-    match precision {
-        Precision::F64 => {
-            crate::rapier::f64::chain::run_row(row, engine, solver, max_time, progress)
-        }
-        Precision::F32 => {
-            crate::rapier::f32::chain::run_row(row, engine, solver, max_time, progress)
-        }
     }
 }

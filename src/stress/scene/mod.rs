@@ -22,7 +22,7 @@ pub(super) mod run;
 
 use std::collections::BTreeMap;
 
-use rayon::prelude::*;
+use crate::par::prelude::*;
 
 pub use draw::{draw_scene, SceneCombo, SceneEngine, SceneKind, StressShape, SHAPES};
 pub use run::{run_scene_combo, SceneObservation};

@@ -420,6 +420,7 @@ fn every_shipped_scene_passes_the_checks() {
         let text = std::fs::read_to_string(&path).unwrap();
         let scene: topple::rapier::scene::Scene =
             topple::validate::parse_toml(&text, &path.display().to_string()).unwrap();
-        topple::validate::scene(&scene).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+        topple::rapier::scene::check_scene(&scene)
+            .unwrap_or_else(|e| panic!("{}: {e}", path.display()));
     }
 }

@@ -5,9 +5,7 @@
 //! deviation of those v̂_i. Numbers quoted are measured with the paper's
 //! integration (improved Euler, Δt = 10⁻⁴ s), push 1.0.
 
-mod common;
-
-use common::cooperative::cooperative_speed;
+use crate::common::cooperative::cooperative_speed;
 use topple::domino::{ChainReport, Preset, RowParams, RowSpec};
 use topple::reference::{run, Settings};
 

@@ -4,8 +4,7 @@
 //! other and against the closed form of a flat bounce, and a pile that
 //! loses bodies mid-run beside a sensor and a kinematic body.
 
-#[path = "../examples/common/scenes.rs"]
-mod scenes;
+use crate::example_scenes as scenes;
 
 use std::time::Duration;
 

@@ -9,7 +9,7 @@
 //! frame within the scene family's bound, the same bits on both runs, and a
 //! flat resident set from the end of the second cycle to the end.
 //!
-//! Long: run it with `cargo test --release --test soak -- --ignored
+//! Long: run it with `cargo test --release --test rapier -- soak:: --ignored
 //! --nocapture`; `docs/stress.md` gives its figures.
 
 use topple::domino::Preset;
@@ -35,7 +35,7 @@ const SHOW: &str = r#"
 const MEMORY_GROWTH: i64 = 512 * 1024;
 
 #[test]
-#[ignore = "long (minutes): cargo test --release --test soak -- --ignored --nocapture"]
+#[ignore = "long (minutes): cargo test --release --test rapier -- soak:: --ignored --nocapture"]
 fn a_domino_show_runs_1e5_frames_clean_with_flat_memory() {
     let scene: Scene = toml::from_str(SHOW).expect("the show parses");
     let spec = SoakSpec::default();

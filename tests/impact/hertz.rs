@@ -1,8 +1,7 @@
 //! e = 1, no friction: the LZB resolver against the compliant model F = k δ^α
 //! integrated in time (docs/model.md).
 
-mod common;
-use common::hertz::Chain;
+use crate::common::hertz::Chain;
 use topple::impact::{Body, Contact, ContactMaterial, ImpactSettings, ImpactSolver};
 
 /// The same chain as resolver input: balls of radius 0.1 m on the x axis.

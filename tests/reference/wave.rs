@@ -3,9 +3,7 @@
 //! conservation laws. Rows of 30 Domino T blocks; the natural speed is the mean
 //! of v̂_i over blocks 7..29.
 
-mod common;
-
-use common::cooperative::cooperative_speed;
+use crate::common::cooperative::cooperative_speed;
 use topple::domino::{ChainReport, Preset, RowSpec};
 use topple::reference::{run, Settings};
 

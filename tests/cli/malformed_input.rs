@@ -9,7 +9,7 @@
 //! number, e.g. the documented run of tens of thousands:
 //!
 //! ```text
-//! TOPPLE_FUZZ_CASES=20000 cargo test --release --test malformed_input
+//! TOPPLE_FUZZ_CASES=20000 cargo test --release --test cli -- malformed_input::
 //! ```
 
 use std::io::Write;
@@ -367,7 +367,7 @@ fn scene_case(text: &str) -> Result<(), TestCaseError> {
             return Ok(());
         }
     };
-    if let Err(e) = topple::validate::scene(&scene) {
+    if let Err(e) = topple::rapier::scene::check_scene(&scene) {
         SEEN[4].fetch_add(1, Relaxed);
         prop_assert!(!e.to_string().contains('\n'), "{e}");
         return Ok(());

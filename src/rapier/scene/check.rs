@@ -1,60 +1,12 @@
-//! A TOML scene: one-line parse errors, every number in range, no
-//! degenerate shape, no two bodies overlapping at the start.
+//! The checks of a parsed scene: every number in range, no degenerate
+//! shape, no two bodies overlapping at the start (the errors name the field,
+//! the value and the range, as [`crate::validate`]'s).
 
-use super::{check_count, check_open_low, check_range, fmt_value, row, EngineKind, InputError};
-use super::{Naming, RunBudget};
+use super::{BodySpec, PairLaw, RowSpec, Scene, ShapeKind};
 use crate::domino::{Preset, RowParams, RowSpec as DominoRow};
-use crate::rapier::scene::{BodySpec, PairLaw, RowSpec, Scene, ShapeKind};
-
-/// A file that does not parse: where and why, on one line.
-#[derive(Clone, Debug, PartialEq, thiserror::Error)]
-#[error("{file}:{line}:{column}: {message}")]
-pub struct SyntaxError {
-    /// The file as named by the user.
-    pub file: String,
-    /// Line, from 1.
-    pub line: usize,
-    /// Column (characters), from 1.
-    pub column: usize,
-    /// What is wrong.
-    pub message: String,
-}
-
-/// Parses TOML text; an error names the file, line and column of its first
-/// character, and toml's message, on one line (toml's own display spreads
-/// over several lines, with a caret that a one-line report misplaces).
-///
-/// ```
-/// use topple::validate::parse_toml;
-/// let e = parse_toml::<topple::rapier::scene::Scene>("duration = 1\nduration = 2\n", "s.toml").unwrap_err();
-/// assert!(e.to_string().starts_with("s.toml:2:1: "), "{e}");
-/// ```
-#[cfg(feature = "scene-files")]
-pub fn parse_toml<T: serde::de::DeserializeOwned>(
-    text: &str,
-    file: &str,
-) -> Result<T, SyntaxError> {
-    toml::from_str(text).map_err(|e: toml::de::Error| {
-        let start = e.span().map(|s| s.start).unwrap_or(0).min(text.len());
-        let before = &text[..floor_char(text, start)];
-        let line = before.matches('\n').count() + 1;
-        let column = before.rsplit('\n').next().map_or(0, |l| l.chars().count()) + 1;
-        SyntaxError {
-            file: file.to_string(),
-            line,
-            column,
-            message: e.message().trim().replace('\n', " "),
-        }
-    })
-}
-
-#[cfg(feature = "scene-files")]
-fn floor_char(text: &str, mut i: usize) -> usize {
-    while !text.is_char_boundary(i) {
-        i -= 1;
-    }
-    i
-}
+use crate::validate::overlap::{overlap, Placed};
+use crate::validate::{check_count, check_open_low, check_range, fmt_value, row, EngineKind};
+use crate::validate::{InputError, Naming, RunBudget};
 
 /// Largest |coordinate| (m) or |speed| (m/s) in a scene.
 const MAX_MAGNITUDE: f64 = 1e6;
@@ -77,10 +29,10 @@ const MAX_BODIES: usize = 100_000;
 ///     position = [0.0, 1.0]
 ///     material = "m"
 /// "#).unwrap();
-/// let e = topple::validate::scene(&scene).unwrap_err();
+/// let e = topple::rapier::scene::check_scene(&scene).unwrap_err();
 /// assert_eq!(e.to_string(), "bodies[0].radius = -0.05: allowed 1e-6 ≤ bodies[0].radius ≤ 1e4");
 /// ```
-pub fn scene(s: &Scene) -> Result<(), InputError> {
+pub fn check_scene(s: &Scene) -> Result<(), InputError> {
     check_open_low("duration", s.duration, 0.0, 1e4)?;
     for k in 0..2 {
         check_range(&format!("gravity[{k}]"), s.gravity[k], -1e3, 1e3)?;
@@ -88,7 +40,7 @@ pub fn scene(s: &Scene) -> Result<(), InputError> {
     let v = &s.solver;
     check_range("solver.dt", v.dt, 1e-6, 1.0 / 30.0)?;
     let steps = (s.duration / v.dt).ceil();
-    if steps > super::row::MAX_RAPIER_STEPS {
+    if steps > crate::validate::row::MAX_RAPIER_STEPS {
         return Err(InputError::new(
             "duration",
             fmt_value(s.duration),
@@ -169,31 +121,6 @@ fn law(at: &str, l: &PairLaw) -> Result<(), InputError> {
     Ok(())
 }
 
-/// A body's shape placed in the plane, for the overlap test.
-#[derive(Clone, Copy, Debug)]
-pub(crate) struct Placed {
-    index: usize,
-    centre: [f64; 2],
-    angle: f64,
-    /// Half extents of a box, or [r, r] of a ball.
-    half: [f64; 2],
-    ball: bool,
-}
-
-impl Placed {
-    /// Radius of the circle around the shape.
-    fn reach(&self) -> f64 {
-        if self.ball {
-            self.half[0]
-        } else {
-            self.half[0].hypot(self.half[1])
-        }
-    }
-    fn size(&self) -> f64 {
-        self.half[0].min(self.half[1])
-    }
-}
-
 fn body(i: usize, b: &BodySpec) -> Result<Placed, InputError> {
     let at = |k: &str| format!("bodies[{i}].{k}");
     let m = MAX_MAGNITUDE;
@@ -244,64 +171,6 @@ fn body(i: usize, b: &BodySpec) -> Result<Placed, InputError> {
     })
 }
 
-/// Depth (m) by which two shapes overlap; ≤ 0 when they do not.
-fn overlap(a: &Placed, b: &Placed) -> f64 {
-    let d = [b.centre[0] - a.centre[0], b.centre[1] - a.centre[1]];
-    match (a.ball, b.ball) {
-        (true, true) => a.half[0] + b.half[0] - d[0].hypot(d[1]),
-        (true, false) => ball_box(a, b),
-        (false, true) => ball_box(b, a),
-        (false, false) => box_box(a, b),
-    }
-}
-
-/// Ball against box: radius minus the distance from the ball's centre to the
-/// box (negative distance inside the box).
-fn ball_box(ball: &Placed, bx: &Placed) -> f64 {
-    let (s, c) = bx.angle.sin_cos();
-    let d = [ball.centre[0] - bx.centre[0], ball.centre[1] - bx.centre[1]];
-    // the ball's centre in the box's frame
-    let p = [c * d[0] + s * d[1], -s * d[0] + c * d[1]];
-    let q = [p[0].abs() - bx.half[0], p[1].abs() - bx.half[1]];
-    let outside = q[0].max(0.0).hypot(q[1].max(0.0));
-    let inside = q[0].max(q[1]).min(0.0);
-    ball.half[0] - (outside + inside)
-}
-
-/// Depth (m) by which two boxes (centre, angle, half extents) overlap, ≤ 0
-/// when they do not (the stress sweep's penetration check).
-pub(crate) fn box_overlap(a: ([f64; 2], f64), b: ([f64; 2], f64), half: [f64; 2]) -> f64 {
-    let placed = |(centre, angle): ([f64; 2], f64)| Placed {
-        index: 0,
-        centre,
-        angle,
-        half,
-        ball: false,
-    };
-    box_box(&placed(a), &placed(b))
-}
-
-/// Box against box by separating axes: the least overlap of their
-/// projections on the four face normals (≤ 0 if some axis separates them).
-fn box_box(a: &Placed, b: &Placed) -> f64 {
-    let axes = |p: &Placed| {
-        let (s, c) = p.angle.sin_cos();
-        [[c, s], [-s, c]]
-    };
-    let (aa, ba) = (axes(a), axes(b));
-    let radius = |p: &Placed, ax: &[[f64; 2]; 2], n: [f64; 2]| {
-        p.half[0] * (ax[0][0] * n[0] + ax[0][1] * n[1]).abs()
-            + p.half[1] * (ax[1][0] * n[0] + ax[1][1] * n[1]).abs()
-    };
-    let d = [b.centre[0] - a.centre[0], b.centre[1] - a.centre[1]];
-    let mut least = f64::INFINITY;
-    for n in aa.iter().chain(ba.iter()) {
-        let depth = radius(a, &aa, *n) + radius(b, &ba, *n) - (d[0] * n[0] + d[1] * n[1]).abs();
-        least = least.min(depth);
-    }
-    least
-}
-
 /// Refuses overlapping bodies (sweep over x by bounding circles) and bodies
 /// below the ground's top face.
 fn no_overlap(shapes: &[Placed], ground: Option<f64>) -> Result<(), InputError> {
@@ -343,7 +212,7 @@ fn no_overlap(shapes: &[Placed], ground: Option<f64>) -> Result<(), InputError> 
 }
 
 /// The row of a scene: its preset and every override in the ranges of
-/// [`super::row()`], named by their scene keys.
+/// [`crate::validate::row()`], named by their scene keys.
 fn scene_row(r: &RowSpec, s: &Scene) -> Result<(), InputError> {
     let preset = match r.preset.to_ascii_uppercase().as_str() {
         "X" => Preset::X,

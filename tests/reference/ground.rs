@@ -3,9 +3,7 @@
 //! closed form, and in the reference engine against the independent
 //! cooperative-model oracle (tests/common/cooperative.rs).
 
-mod common;
-
-use common::cooperative::cooperative_speed;
+use crate::common::cooperative::cooperative_speed;
 use topple::domino::{Ground, Preset, RowSpec};
 use topple::impact::{resolve, Body, Contact, ContactMaterial, ImpactSettings};
 use topple::reference::{run, Settings};

@@ -4,8 +4,7 @@
 //! and friction, the conservation checks and agreement of the two step
 //! controls.
 
-mod common;
-use common::{compliant, leaning::Leaning};
+use crate::common::{compliant, leaning::Leaning};
 use topple::impact::{ContactMaterial, ImpactSettings, ImpactSolver};
 
 fn elastic_group() -> Leaning {
@@ -129,7 +128,7 @@ fn load(text: &str) -> (Vec<topple::impact::Body>, Vec<topple::impact::Contact>)
 /// the struck block must come away rotating forward (clockwise).
 #[test]
 fn domino_first_hit_ends_and_dissipates() {
-    let (bodies, contacts) = load(include_str!("data/domino-x-first-hit.json"));
+    let (bodies, contacts) = load(include_str!("../data/domino-x-first-hit.json"));
     for settings in [
         ImpactSettings {
             max_steps: 200_000,
@@ -158,7 +157,7 @@ fn domino_first_hit_ends_and_dissipates() {
 /// law (no held contacts), and agree with the fixed step at ΔP = 10⁻⁵ P₀.
 #[test]
 fn wedged_e0_group_ends_with_the_adaptive_step() {
-    let (bodies, contacts) = load(include_str!("data/ideal-t-wedged-group.json"));
+    let (bodies, contacts) = load(include_str!("../data/ideal-t-wedged-group.json"));
     let fine = ImpactSolver::new()
         .solve(&bodies, &contacts, &ImpactSettings::fixed(1e-5))
         .unwrap();
@@ -203,7 +202,7 @@ fn wedged_e0_group_ends_with_the_adaptive_step() {
 /// times its tolerance.
 #[test]
 fn flat_lying_pile_impact_ends_and_matches_the_impulse_stepping() {
-    let (bodies, contacts) = load(include_str!("data/domino-x-flat-pile.json"));
+    let (bodies, contacts) = load(include_str!("../data/domino-x-flat-pile.json"));
     let fine = ImpactSolver::new()
         .solve(
             &bodies,

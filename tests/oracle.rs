@@ -1,2 +1,0 @@
-//! Checks the test oracle itself against published values.
-mod common;

@@ -1,0 +1,16 @@
+//! The Rapier plugin in both builds, the scenes and the stress sweep's checks, against closed forms, conservation laws and the reference engine.
+//!
+//! One test binary per layer (so each links the crate once); each file below
+//! was a test binary of its own and keeps its tests and tolerances.
+
+mod costs;
+mod cradle;
+mod determinism;
+mod dominoes;
+mod drop;
+mod game_rate;
+mod shapes;
+mod sleeping;
+mod soak;
+mod stress_checks;
+mod vs_reference;
