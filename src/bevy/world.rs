@@ -13,7 +13,7 @@ use crate::rapier::ToppleStats;
 /// this material (energetic restitution e, Coulomb friction μ and μₛ,
 /// stiffness k and exponent α of the contact law, and the smooth-phase
 /// friction Rapier uses between impacts). Entities without it stay plain
-/// Rapier. Put it on the entity that holds the [`Collider`].
+/// Rapier. Put it on the entity that holds the [`Collider`](bevy_rapier2d::prelude::Collider).
 ///
 /// Two colliders of the same material use it as it is; two different
 /// materials combine by [`PairMaterial::combine`] unless a pair rule is set

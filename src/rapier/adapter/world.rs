@@ -170,7 +170,7 @@ impl ToppleRapier {
 
     /// The settings of the last step in the world's units: the impact
     /// threshold and tolerances derived from its length unit, gravity and
-    /// step ([`super::scale`]).
+    /// step (docs/bevy.md, "Settings follow the scene").
     pub fn step_settings(&self) -> &ToppleSettings {
         &self.effective
     }
@@ -294,7 +294,7 @@ impl ToppleRapier {
     /// [`crate::coupling::FallbackPolicy::max_work`]; once it is spent, the
     /// impact that ran out is finished by the fallback policy and the rest
     /// of the step is native Rapier (counted in [`ToppleStats`]). Lengths
-    /// and speeds of the settings are per length unit ([`super::scale`]).
+    /// and speeds of the settings are per length unit (docs/bevy.md, "Settings follow the scene").
     /// Returns the number of impact groups resolved. Never fails. An app
     /// that calls Rapier's step itself uses [`ToppleRapier::begin_step`],
     /// Rapier's step with [`ToppleRapier::hooks`], then

@@ -161,7 +161,7 @@ pub struct SceneOutput {
     pub row: Option<ChainReport>,
 }
 
-/// Options of [`run_scene`].
+/// Options of [`run_scene`](super::run_scene).
 #[derive(Clone, Debug, Default)]
 pub struct RunOptions {
     /// Stop a row scene once its last block has been hit.

@@ -9,7 +9,7 @@ use crate::rapier::scene::{
 use crate::rapier::Precision;
 
 /// A shape the scenes draw. Each is built from one size (m) by
-/// [`StressShape::body`]; a shape the plugin gains is one more variant there
+/// `StressShape::body`; a shape the plugin gains is one more variant there
 /// and one more entry in [`SHAPES`].
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum StressShape {
