@@ -138,6 +138,11 @@ pub struct Args {
     /// struck pair beyond which bodies are left out of an impact.
     #[arg(long, default_value_t = topple::coupling::ToppleSettings::DEFAULT_WINDOW)]
     pub window: usize,
+    /// Rapier engines: an impact ends once what is left of it is slower
+    /// than this fraction of the impact threshold (default 0.01; 0: every
+    /// impact runs to its end; docs/model.md §9).
+    #[arg(long, allow_hyphen_values = true)]
+    pub rest_fraction: Option<f64>,
     /// Rapier engines: stop after this much simulated time (s) if the last
     /// block has not been hit.
     #[arg(long, allow_hyphen_values = true, default_value_t = 60.0)]
@@ -275,6 +280,9 @@ fn check_args(args: &Args) -> anyhow::Result<RowSpec> {
         }),
     )?;
     validate::check_count("--window", args.window, 1, 1_000_000)?;
+    if let Some(f) = args.rest_fraction {
+        validate::check_range("--rest-fraction", f, 0.0, 1.0)?;
+    }
     if let Some(f) = args.freeze_tolerance {
         validate::check_range("--freeze-tolerance", f, 0.0, 1.0)?;
     }
@@ -371,6 +379,7 @@ fn run_rapier(args: &Args, row: &RowSpec, engine: Engine) -> anyhow::Result<()> 
             dt: args.dt,
             tolerance: args.tolerance,
             max_group_hops: Some(args.window),
+            rest_fraction: args.rest_fraction,
             ..Default::default()
         },
         max_time: args.max_time,

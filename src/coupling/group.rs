@@ -500,10 +500,11 @@ impl ImpactGroups {
             max_work: s.fallback.max_work.map(|w| w.saturating_sub(self.work)),
             ..s.fallback
         };
+        let impact = s.impact_settings();
         let result = self.solver.solve_into(
             &self.group_bodies,
             &self.group_contacts,
-            &s.impact,
+            &impact,
             &policy,
             &mut self.outcome,
         );

@@ -56,6 +56,17 @@ pub struct ToppleSettings {
     /// the impacts dominate the cost and the impact threshold stays the
     /// frame's (docs/game-rate.md). Default 1/240 s.
     pub max_substep: Option<f64>,
+    /// What is left of an impact once everything in it is slower than this
+    /// fraction of the impact threshold (`min_approach_speed`, in the
+    /// world's units) is the engine's: the resolver ends there
+    /// ([`ImpactSettings::rest_speed`] = `rest_fraction` ·
+    /// `min_approach_speed`; docs/model.md §9). Contacts that approach
+    /// slower than the threshold are the engine's resting contacts at the
+    /// start of a step; the impact's tail is left to them at a hundredth of
+    /// that speed. 0: every impact runs to its end under the paper's law
+    /// (a box landing on a resting pile then sloshes for seconds of the
+    /// impact's own time). Default [`ToppleSettings::DEFAULT_REST_FRACTION`].
+    pub rest_fraction: f64,
 }
 
 impl ToppleSettings {
@@ -71,6 +82,31 @@ impl ToppleSettings {
     /// contact points, [`FallbackPolicy::max_work`]), measured in
     /// docs/bevy.md ("Bounded frames").
     pub const DEFAULT_STEP_WORK: u64 = 50_000;
+
+    /// The default [`ToppleSettings::rest_fraction`].
+    pub const DEFAULT_REST_FRACTION: f64 = 0.01;
+
+    /// The resolver's settings for an impact under these settings: `impact`
+    /// with its rest speed raised to `rest_fraction · min_approach_speed`.
+    ///
+    /// ```
+    /// use topple::coupling::ToppleSettings;
+    /// let s = ToppleSettings { min_approach_speed: 0.3, ..ToppleSettings::default() };
+    /// assert_eq!(s.impact_settings().rest_speed, 0.3 * ToppleSettings::DEFAULT_REST_FRACTION);
+    /// let exact = ToppleSettings { rest_fraction: 0.0, ..s };
+    /// assert_eq!(exact.impact_settings().rest_speed, 0.0);
+    /// ```
+    pub fn impact_settings(&self) -> ImpactSettings {
+        let floor = self.rest_fraction * self.min_approach_speed;
+        ImpactSettings {
+            rest_speed: if floor > 0.0 && floor.is_finite() {
+                self.impact.rest_speed.max(floor)
+            } else {
+                self.impact.rest_speed
+            },
+            ..self.impact
+        }
+    }
 }
 
 impl Default for ToppleSettings {
@@ -86,6 +122,7 @@ impl Default for ToppleSettings {
             },
             max_splits: 4,
             max_substep: Some(1.0 / 240.0),
+            rest_fraction: Self::DEFAULT_REST_FRACTION,
         }
     }
 }

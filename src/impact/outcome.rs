@@ -22,6 +22,11 @@ pub enum StopReason {
     NoApproach,
     /// Every contact released its energy and none approaches any more.
     Released,
+    /// What was left of the impact was slower than
+    /// [`crate::impact::ImpactSettings::rest_speed`]: no point approached
+    /// faster, none stored the energy to rebound faster. The stored energy
+    /// left was dropped; the slow approaches are the engine's to stop.
+    AtRest,
 }
 
 /// Result of [`crate::impact::ImpactSolver::solve`].

@@ -107,6 +107,12 @@ pub(crate) fn check(
             settings.fast_cycle
         )));
     }
+    if !(settings.rest_speed >= 0.0 && settings.rest_speed.is_finite()) {
+        return Err(ImpactError::InvalidSettings(format!(
+            "rest_speed {} is not finite and >= 0",
+            settings.rest_speed
+        )));
+    }
     if settings.max_steps == 0 {
         return Err(ImpactError::InvalidSettings("max_steps is 0".into()));
     }

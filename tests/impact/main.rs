@@ -9,4 +9,5 @@ mod friction;
 mod group;
 mod hertz;
 mod properties;
+mod rest;
 mod single;

@@ -263,6 +263,9 @@ pub(crate) struct Integrator {
     /// An e = 0 point is held after a load cycle that moved its rate by at
     /// most this much of the velocity scale (∞ with e0_hold).
     fast_cycle: f64,
+    /// The impact ends once everything left is slower than this (m/s,
+    /// [`ImpactSettings::rest_speed`]; 0: never before its end).
+    rest_speed: f64,
     // evolving
     y: Vec<f64>,
     clock: Clock,
@@ -307,6 +310,7 @@ impl Integrator {
         } else {
             settings.fast_cycle
         };
+        self.rest_speed = settings.rest_speed;
         self.min_step = 1e-14 * self.scales.time;
         let len = self.layout.len();
         self.probe_state.resize(len, 0.0);

@@ -12,6 +12,10 @@
 //! are constant: the gaps move linearly and the loop jumps to the first one
 //! that closes (paper Sec. 2.3: the micro-gaps of the frozen positions), or
 //! ends the impact when none approaches.
+//!
+//! With a rest speed ([`crate::impact::ImpactSettings::rest_speed`]) the
+//! impact also ends as soon as no point approaches faster than it and none
+//! stores the energy to rebound faster (docs/model.md §9).
 
 use super::super::{ImpactError, ImpactOutcome, StopReason};
 use super::rhs::normal_rate;
@@ -61,6 +65,11 @@ impl Controller {
 /// of √T at the tolerance 10⁻⁵ (T the point's time scale, law.rs).
 const ONSET_STEP: f64 = 0.3;
 
+/// A switch landed on within this fraction of the step it was found in
+/// makes no progress if it is one of a run of such switches
+/// (see `standstill` in the loop).
+const CRAWL: f64 = 1e-5;
+
 /// A root segment goes on in time once x is this many steps past the onset
 /// (the t^α start is resolved by then).
 const ROOT_SPAN: f64 = 3.0;
@@ -97,13 +106,19 @@ impl Integrator {
         // than one per point without a step in between is a loop that makes
         // no progress (a point that closes but does not load)
         let mut flights = 0usize;
-        // switches landed on one after another without time moving on: the
-        // modes cycle at one instant (a set of stick/slip conditions with
-        // no consistent choice); more than any settling could need is a
-        // loop that makes no progress
+        // switches landed on one after another without time moving on, or
+        // moving by a vanishing part of each step: the modes cycle at one
+        // instant (a set of stick/slip conditions with no consistent
+        // choice, e.g. a stuck patch at its bound μ_s N that breaks loose
+        // and, sliding with μ < μ_s, is turned back to sticking by the rows
+        // around it); more than any settling could need is a loop that
+        // makes no progress
         let mut standstill = 0usize;
         let standstill_cap = 8 + 2 * (self.rows.len() + self.patches.len());
         loop {
+            if self.rest_speed > 0.0 && self.at_rest() {
+                return Ok(StopReason::AtRest);
+            }
             if !self.any_loaded() {
                 if !self.free_flight() {
                     return Ok(StopReason::Released);
@@ -155,7 +170,8 @@ impl Integrator {
             if let Some(theta) = switch {
                 let before = self.y[self.layout.time()];
                 self.land(rk, theta);
-                if self.y[self.layout.time()] - before <= self.min_step {
+                let moved = self.y[self.layout.time()] - before;
+                if moved <= self.min_step || theta <= CRAWL {
                     standstill += 1;
                     if standstill > standstill_cap {
                         return Err(ImpactError::StepLimit { steps: out.steps });
@@ -192,6 +208,29 @@ impl Integrator {
                 }
             }
         }
+    }
+
+    /// Whether every point approaches slower than the rest speed and stores
+    /// too little energy to rebound faster: √(2 e² E(q) W_nn) below it,
+    /// e² E(q) being what the point gives back from compression q, whether
+    /// it is still compressing or already expanding (law.rs).
+    fn at_rest(&self) -> bool {
+        let lay = self.layout;
+        let rest = self.rest_speed;
+        self.rows.iter().enumerate().all(|(i, row)| {
+            if !row.movable {
+                return true;
+            }
+            if -normal_rate(row, &self.y) > rest {
+                return false;
+            }
+            let q = self.y[lay.q(i)];
+            if q <= 0.0 || self.points[i].mode == PointMode::Held {
+                return true;
+            }
+            let rebound = row.law.restitution_sq() * row.law.energy(q);
+            2.0 * rebound * row.w_nn <= rest * rest
+        })
     }
 
     /// Time (s) covered by the last step.

@@ -71,6 +71,10 @@ pub fn check_scene(s: &Scene) -> Result<(), InputError> {
             check_range("solver.dt / solver.max_substep", v.dt / x, 0.0, 1e3)?;
         }
     }
+    if let Some(x) = v.rest_fraction {
+        // above 1 the impact would end before it resolved what it started on
+        check_range("solver.rest_fraction", x, 0.0, 1.0)?;
+    }
     check_range("solver.closed_tolerance", v.closed_tolerance, 0.0, 1.0)?;
     for (i, m) in s.materials.iter().enumerate() {
         law(

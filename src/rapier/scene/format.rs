@@ -94,6 +94,10 @@ pub struct SolverSpec {
     /// Rapier steps split at predicted impact instants, at most, per step
     /// (default 4; 0 never splits).
     pub max_splits: Option<usize>,
+    /// The impact ends once what is left of it is slower than this fraction
+    /// of the impact threshold ([`crate::coupling::ToppleSettings::rest_fraction`];
+    /// default 0.01, 0: every impact runs to its end).
+    pub rest_fraction: Option<f64>,
     /// Steps longer than this (s) are taken as equal sub-steps no longer
     /// than it ([`crate::coupling::ToppleSettings::max_substep`], default
     /// 1/240 s); 0: never sub-step. Native Rapier never sub-steps.
@@ -113,6 +117,7 @@ impl Default for SolverSpec {
             length_unit: None,
             contact_hertz: None,
             max_splits: None,
+            rest_fraction: None,
             iterations: 4,
             contact_recycling: true,
             impulse_step: None,

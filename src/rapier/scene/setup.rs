@@ -109,6 +109,9 @@ pub fn topple_settings(s: &SolverSpec, length_unit: f64) -> ToppleSettings {
             None => ToppleSettings::default().max_substep,
             Some(h) => (h > 0.0).then_some(h),
         },
+        rest_fraction: s
+            .rest_fraction
+            .unwrap_or(ToppleSettings::DEFAULT_REST_FRACTION),
     }
 }
 
