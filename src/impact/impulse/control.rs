@@ -1,4 +1,4 @@
-//! Stage 7: step control — the paper's fixed step ΔP = STEP · P₀ (paper
+//! Stage 7: the entry and step control — the paper's fixed step ΔP = STEP · P₀ (paper
 //! Sec. 3.1, docs/model.md §6) and the adaptive impulse step with its local
 //! error estimates; the step limit and the finiteness check.
 //!
@@ -16,12 +16,62 @@
 //! h · clamp(0.9/√err, 0.1, 0.9); an accepted one grows by
 //! clamp(0.9/√err, 0.2, 5), from what a landing let it take.
 
-use super::super::{ImpactError, ImpactOutcome, StopReason};
+use super::super::{Body, Contact, ImpactError, ImpactOutcome, ImpactSettings, StopReason};
+use super::data::ImpulseStepper;
 use super::law::Start;
 use super::step::Step;
-use super::ImpulseStepper;
+
+/// The two ways of stepping the impulse.
+#[derive(Clone, Copy, Debug)]
+pub(crate) enum ImpulseScheme {
+    /// [`crate::impact::StepControl::Fixed`].
+    Fixed { impulse_step: f64 },
+    /// [`crate::impact::StepControl::AdaptiveImpulse`].
+    Adaptive { tolerance: f64 },
+}
+
+/// Landing fractions at or below this are not worth a step of their own.
+pub(super) const MIN_LANDING: f64 = 1e-9;
 
 impl ImpulseStepper {
+    /// Resolves one validated impact into `out` with a fixed or an adaptive
+    /// impulse step. Errors: the step limit or a non-finite state.
+    pub(crate) fn solve_into(
+        &mut self,
+        bodies: &[Body],
+        contacts: &[Contact],
+        scheme: ImpulseScheme,
+        settings: &ImpactSettings,
+        out: &mut ImpactOutcome,
+    ) -> Result<(), ImpactError> {
+        self.load(bodies, contacts);
+        self.elapsed = 0.0;
+        self.e0_hold = settings.e0_hold;
+        out.kinetic_energy_before = bodies.iter().map(Body::kinetic_energy).sum();
+        out.steps = 0;
+        out.rejected_steps = 0;
+
+        let reason = if self.scales.velocity == 0.0 {
+            StopReason::NoApproach
+        } else {
+            match scheme {
+                ImpulseScheme::Fixed { impulse_step } => {
+                    self.adaptive = false;
+                    let h = impulse_step * self.scales.impulse;
+                    self.landing_impulse = MIN_LANDING * h;
+                    self.run_fixed(h, settings.max_steps, out)?
+                }
+                ImpulseScheme::Adaptive { tolerance } => {
+                    self.adaptive = true;
+                    self.landing_impulse = MIN_LANDING * 1e-4 * self.scales.impulse;
+                    self.run_adaptive(tolerance, settings.max_steps, out)?
+                }
+            }
+        };
+        self.finish(bodies, reason, out);
+        Ok(())
+    }
+
     /// The paper's scheme: steps of primary impulse `h` until the impact ends.
     pub(super) fn run_fixed(
         &mut self,

@@ -8,8 +8,7 @@
 //! dt = ∫ dP_p / F_p(E_p) (the contact law, docs/model.md §1 and §7) and the
 //! gaps g += ∫ δ̇ dt of the contacts without energy.
 
-use super::load::{BodySlot, ContactState, Row};
-use super::{ImpulseStepper, Scratch};
+use super::data::{BodySlot, ContactState, ImpulseStepper, Row, Scratch};
 
 /// Gauss–Legendre nodes on [0, 1] and weights (4 points, exact for
 /// polynomials of degree 7).

@@ -4,7 +4,7 @@
 //! and the engines' guards check that it never grows, docs/model.md §2).
 
 use super::super::{Body, BodyVelocity, ContactImpulse, ImpactOutcome, StopReason};
-use super::ImpulseStepper;
+use super::data::ImpulseStepper;
 
 impl ImpulseStepper {
     /// Writes the impact's result into `out`, reusing its vectors.

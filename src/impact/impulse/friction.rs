@@ -15,8 +15,7 @@
 //!
 //! [`ImpactSettings::e0_hold`]: super::super::ImpactSettings::e0_hold
 
-use super::load::{Axis, BodySlot, ContactState, Row};
-use super::{ImpulseStepper, Scratch};
+use super::data::{Axis, BodySlot, ContactState, ImpulseStepper, Row, Scratch};
 
 /// Friction sweeps per step at most, and the slip correction (relative to
 /// the velocity scale) below which they stop.

@@ -19,8 +19,7 @@
 //!
 //! [`MIN_LANDING`]: super::MIN_LANDING
 
-use super::load::{ContactState, Row};
-use super::{ImpulseStepper, Scratch};
+use super::data::{ContactState, ImpulseStepper, Row, Scratch};
 
 /// What one contact's events need besides its own data.
 #[derive(Clone, Copy, Debug)]

@@ -13,9 +13,8 @@
 //!
 //! [`ImpactSettings::e0_hold`]: super::super::ImpactSettings::e0_hold
 
-use super::load::{ContactState, Row};
+use super::data::{ContactState, ImpulseStepper, Row};
 use super::step::Stage;
-use super::ImpulseStepper;
 
 /// The primary contact of a step and its force.
 #[derive(Clone, Copy, Debug)]

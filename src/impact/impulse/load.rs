@@ -1,9 +1,8 @@
 //! Stage 1: the impact's frozen data — body slots, contact rows, the scales
 //! P₀, the velocity scale and the approach threshold (docs/model.md §3, §6) —
-//! and the initial state; the kinematics every stage shares.
+//! and the initial state, into the buffers of data.rs.
 //!
-//! Equations: the normal rate δ̇ = n·(v_b + ω_b × r_b − v_a − ω_a × r_a)
-//! (negative while approaching, m/s) and its tangential twin; the diagonal
+//! Equations: the diagonal
 //! W_ii = m_a⁻¹ + (r_a×n)² I_a⁻¹ + m_b⁻¹ + (r_b×n)² I_b⁻¹ of the Delassus
 //! operator (1/kg); the force prefactor c = (α+1)^(α/(α+1)) k^(1/(α+1)) of
 //! F(E) = c E^(α/(α+1)) (docs/model.md §1); an impulse p along a direction
@@ -11,149 +10,9 @@
 
 use super::super::contact::cross;
 use super::super::{Body, Contact};
-use super::energy::warped_nodes;
-use super::{ImpulseStepper, Scratch};
-
-/// Inverse mass (1/kg) and inverse inertia (1/(kg·m²)) of a body slot: 0
-/// for fixed bodies and the world.
-#[derive(Clone, Copy, Debug, Default)]
-pub(super) struct BodySlot {
-    pub inv_mass: f64,
-    pub inv_inertia: f64,
-}
-
-/// Frozen geometry and material of one contact.
-#[derive(Clone, Copy, Debug, Default)]
-pub(super) struct Row {
-    /// Body slots (the world is the last slot).
-    pub a: usize,
-    pub b: usize,
-    pub normal: [f64; 2],
-    pub tangent: [f64; 2],
-    /// r×n and r×t for each body (r from the centre of mass to the point).
-    pub a_rn: f64,
-    pub a_rt: f64,
-    pub b_rn: f64,
-    pub b_rt: f64,
-    /// Diagonal entries of the Delassus operator along n and t (1/kg).
-    pub w_nn: f64,
-    pub w_tt: f64,
-    /// c = (α+1)^(α/(α+1)) k^(1/(α+1)), so F(E) = c E^(α/(α+1)).
-    pub force_coeff: f64,
-    /// α/(α+1).
-    pub power: f64,
-    pub exponent: f64,
-    pub restitution: f64,
-    pub friction: f64,
-    pub stick_friction: f64,
-    /// False when neither body can move: such a contact takes no part.
-    pub movable: bool,
-}
-
-/// A direction of impulse with its moment arms r×dir on the two bodies.
-#[derive(Clone, Copy, Debug)]
-pub(super) struct Axis {
-    pub dir: [f64; 2],
-    pub arm_a: f64,
-    pub arm_b: f64,
-}
-
-/// Evolving state of one contact.
-#[derive(Clone, Copy, Debug, Default)]
-pub(super) struct ContactState {
-    /// Stored potential energy E (J).
-    pub energy: f64,
-    pub normal_impulse: f64,
-    pub tangent_impulse: f64,
-    pub peak_energy: f64,
-    /// Separation opened after release (m); the contact is closed while 0.
-    pub gap: f64,
-    /// Stick (true) or slip (false) for the friction law.
-    pub sticking: bool,
-    /// e = 0 contact whose compression has ended without separating: held
-    /// closed by a non-negative impulse (the sliding-mode limit of e = 0).
-    pub held: bool,
-}
-
-/// Scales of one impact, fixed at its start.
-#[derive(Clone, Copy, Debug, Default)]
-pub(super) struct Scales {
-    /// P₀ (N·s), see [`crate::impact::StepControl::Fixed`].
-    pub impulse: f64,
-    /// Largest approach speed at the start (m/s).
-    pub velocity: f64,
-    /// Rates above −threshold count as not approaching (m/s).
-    pub threshold: f64,
-}
+use super::data::{warped_nodes, BodySlot, ContactState, ImpulseStepper, Row, Scales, Scratch};
 
 impl Row {
-    #[inline]
-    pub fn normal_axis(&self) -> Axis {
-        Axis {
-            dir: self.normal,
-            arm_a: self.a_rn,
-            arm_b: self.b_rn,
-        }
-    }
-
-    #[inline]
-    pub fn tangent_axis(&self) -> Axis {
-        Axis {
-            dir: self.tangent,
-            arm_a: self.a_rt,
-            arm_b: self.b_rt,
-        }
-    }
-
-    /// δ̇ = n·(v_b + ω_b × r_b − v_a − ω_a × r_a) (m/s).
-    #[inline]
-    pub fn normal_rate(&self, v: &[[f64; 3]]) -> f64 {
-        let (va, vb) = (v[self.a], v[self.b]);
-        self.normal[0] * (vb[0] - va[0]) + self.normal[1] * (vb[1] - va[1]) + vb[2] * self.b_rn
-            - va[2] * self.a_rn
-    }
-
-    /// Tangential relative velocity along t (m/s).
-    #[inline]
-    pub fn tangent_rate(&self, v: &[[f64; 3]]) -> f64 {
-        let (va, vb) = (v[self.a], v[self.b]);
-        self.tangent[0] * (vb[0] - va[0]) + self.tangent[1] * (vb[1] - va[1]) + vb[2] * self.b_rt
-            - va[2] * self.a_rt
-    }
-
-    /// Applies impulse `p` (N·s) along `axis` to the row's bodies: −p on a,
-    /// +p on b.
-    #[inline]
-    pub fn apply(&self, axis: Axis, p: f64, slots: &[BodySlot], v: &mut [[f64; 3]]) {
-        let Axis { dir, arm_a, arm_b } = axis;
-        let (sa, sb) = (slots[self.a], slots[self.b]);
-        let (ma, ia) = (sa.inv_mass * p, sa.inv_inertia * p);
-        let va = &mut v[self.a];
-        va[0] -= ma * dir[0];
-        va[1] -= ma * dir[1];
-        va[2] -= ia * arm_a;
-        let (mb, ib) = (sb.inv_mass * p, sb.inv_inertia * p);
-        let vb = &mut v[self.b];
-        vb[0] += mb * dir[0];
-        vb[1] += mb * dir[1];
-        vb[2] += ib * arm_b;
-    }
-
-    /// The contact has friction along its tangent.
-    #[inline]
-    pub fn has_friction(&self) -> bool {
-        self.w_tt > 0.0 && (self.friction > 0.0 || self.stick_friction > 0.0)
-    }
-
-    /// Unbounded friction (μ = ∞, [`ContactMaterial::no_slip`]): the
-    /// contact never slides while it takes normal impulse.
-    ///
-    /// [`ContactMaterial::no_slip`]: super::super::ContactMaterial::no_slip
-    #[inline]
-    pub fn no_slip(&self) -> bool {
-        self.friction == f64::INFINITY
-    }
-
     /// The row of `c`: its frame, Delassus diagonal and law.
     fn new(c: &Contact, bodies: &[Body], slots: &[BodySlot]) -> Row {
         let frame = c.frame(bodies);

@@ -5,7 +5,7 @@
 //! in h. The explicit step both halves share runs steps 1–7 of the module
 //! docs in order, each in its own stage file.
 
-use super::ImpulseStepper;
+use super::data::ImpulseStepper;
 
 /// The two halves of an improved-Euler step.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
