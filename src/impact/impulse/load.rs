@@ -5,8 +5,9 @@
 //! Equations: the diagonal
 //! W_ii = m_a⁻¹ + (r_a×n)² I_a⁻¹ + m_b⁻¹ + (r_b×n)² I_b⁻¹ of the Delassus
 //! operator (1/kg); the force prefactor c = (α+1)^(α/(α+1)) k^(1/(α+1)) of
-//! F(E) = c E^(α/(α+1)) (docs/model.md §1); an impulse p along a direction
-//! changes the velocities by ∓ M⁻¹ (dir, r × dir) p.
+//! F(E) = c E^(α/(α+1)) (docs/model.md §1); P₀ = max(|Σ m v| of the free
+//! bodies, max_i |δ̇_i| / W_ii) (docs/model.md §3); the threshold 10⁻⁹ of
+//! the largest approach speed (rounding left after a landing).
 
 use super::super::contact::cross;
 use super::super::{Body, Contact};

@@ -54,8 +54,8 @@
 //! | file | stage |
 //! | --- | --- |
 //! | `data.rs` | the layout: the stepper's buffers, per-contact row, state and scratch, body slots; contact kinematics |
-//! | `load.rs` | body slots, contact rows, scales, the initial state; contact rates and applying an impulse |
-//! | `law.rs` | the contact law F(E) and the distributing law: each contact's increment for a primary step (steps 2–3) |
+//! | `load.rs` | body slots, contact rows, the scales P₀ and the approach threshold, the initial state |
+//! | `law.rs` | the contact law F(E), the primary contact and the distributing law: each contact's increment for a primary step (steps 1–3) |
 //! | `step.rs` | one improved-Euler step: predictor, corrector, the explicit step they share, commit |
 //! | `friction.rs` | held points and Coulomb friction with stick and slip, by projected Gauss–Seidel (step 4) |
 //! | `landing.rs` | the first switch inside a step and the switches due at once (step 5); free flight to a closing gap |
