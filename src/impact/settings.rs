@@ -101,13 +101,13 @@ pub struct ImpactSettings {
     #[serde(default = "default_fast_cycle")]
     pub fast_cycle: f64,
     /// The speed (m/s, or the world's length unit per second) below which
-    /// what is left of an impact belongs to the engine's resting contacts,
-    /// time-domain solver only. The impact ends as soon as no contact point
+    /// what is left of an impact belongs to the engine's resting contacts.
+    /// The impact ends as soon as no contact point
     /// approaches faster than this and none stores the energy to rebound
     /// faster than this (√(2 e² E W_nn), docs/model.md §9): the stored
     /// energy left is dropped (dissipated, never created) and the slow
     /// approaches are left to the engine, which stops them as it stops a
-    /// resting contact. 0 (default): the impact runs to its end as the
+    /// resting contact. Every integrator. 0 (default): the impact runs to its end as the
     /// paper's law defines it. A pile of resting boxes that one box lands
     /// on never ends under that law (the wave keeps sloshing between boxes
     /// held by the frozen positions, ever slower); an engine that steps at

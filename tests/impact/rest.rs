@@ -8,7 +8,8 @@
 use topple::coupling::{FallbackPolicy, GroupSolver, Resolution};
 use topple::impact::audit::{check, AuditSummary};
 use topple::impact::{
-    Body, Contact, ImpactError, ImpactOutcome, ImpactSettings, ImpactSolver, StopReason,
+    Body, Contact, ImpactError, ImpactOutcome, ImpactSettings, ImpactSolver, StepControl,
+    StopReason,
 };
 
 fn load(text: &str) -> (Vec<Body>, Vec<Contact>) {
@@ -73,55 +74,55 @@ fn approach(bodies: &[Body], out: &ImpactOutcome, c: &Contact) -> f64 {
 #[test]
 fn a_pile_landing_ends_at_the_rest_speed_and_tends_to_the_law_as_it_falls() {
     let (bodies, contacts) = load(include_str!("../data/pile-landing-33-contacts.json"));
-    let v = speed(&bodies);
+    // the time-domain solver and the paper's impulse stepping (adaptive)
+    for base in [
+        ImpactSettings::default(),
+        ImpactSettings::adaptive_impulse(1e-4),
+    ] {
+        ends_at_the_rest_speed(&bodies, &contacts, base);
+    }
+}
+
+fn ends_at_the_rest_speed(bodies: &[Body], contacts: &[Contact], base: ImpactSettings) {
+    let v = speed(bodies);
     let mut solver = ImpactSolver::new();
-    let full = solver
-        .solve(&bodies, &contacts, &ImpactSettings::default())
-        .unwrap();
+    let full = solver.solve(bodies, contacts, &base).unwrap();
     assert_eq!(full.stop_reason, Some(StopReason::Released));
     let mut previous = f64::INFINITY;
     for fraction in [1e-2, 1e-3, 1e-4, 1e-6] {
         let rest = fraction * v;
         let settings = ImpactSettings {
             rest_speed: rest,
-            ..ImpactSettings::default()
+            ..base
         };
-        let out = solver.solve(&bodies, &contacts, &settings).unwrap();
-        assert_eq!(out.stop_reason, Some(StopReason::AtRest), "{fraction}");
-        assert!(out.steps < full.steps, "{fraction}: {} steps", out.steps);
+        let out = solver.solve(bodies, contacts, &settings).unwrap();
+        let case = format!("{:?} at {fraction}", base.step_control);
+        assert_eq!(out.stop_reason, Some(StopReason::AtRest), "{case}");
+        assert!(out.steps < full.steps, "{case}: {} steps", out.steps);
         let mut audit = AuditSummary::default();
-        check(&bodies, &contacts, &out, &mut audit);
-        assert!(audit.consistency < 1e-9, "{fraction}: {audit:?}");
-        assert!(audit.energy_gain <= 0.0, "{fraction}: {audit:?}");
-        for c in &contacts {
-            let closing = approach(&bodies, &out, c);
+        check(bodies, contacts, &out, &mut audit);
+        assert!(audit.consistency < 1e-9, "{case}: {audit:?}");
+        assert!(audit.energy_gain <= 0.0, "{case}: {audit:?}");
+        for c in contacts {
+            let closing = approach(bodies, &out, c);
+            assert!(closing <= rest * (1.0 + 1e-6), "{case}: {closing} > {rest}");
+        }
+        let off = difference(bodies, &out, &full) / v;
+        assert!(off < previous, "{case}: {off:.2e} after {previous:.2e}");
+        // the time-domain solver's steps go to the tail, the impulse
+        // stepping's mostly to the wave itself (11,903 → 8,530 there)
+        if fraction == 1e-2 && matches!(base.step_control, StepControl::Adaptive { .. }) {
             assert!(
-                closing <= rest * (1.0 + 1e-6),
-                "{fraction}: {closing} > {rest}"
+                out.steps * 3 < full.steps,
+                "{case}: {} of {}",
+                out.steps,
+                full.steps
             );
         }
-        let off = difference(&bodies, &out, &full) / v;
-        assert!(off < previous, "{fraction}: {off:.2e} after {previous:.2e}");
         previous = off;
     }
     // at 10⁻⁶ of the speed the outcome is the law's to its tolerance
     assert!(previous < 1e-4, "{previous:.2e}");
-    let first = solver
-        .solve(
-            &bodies,
-            &contacts,
-            &ImpactSettings {
-                rest_speed: 1e-2 * v,
-                ..ImpactSettings::default()
-            },
-        )
-        .unwrap();
-    assert!(
-        first.steps * 3 < full.steps,
-        "{} of {}",
-        first.steps,
-        full.steps
-    );
 }
 
 /// A rest speed at or above every approach ends the impact before it

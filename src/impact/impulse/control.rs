@@ -12,6 +12,10 @@
 //! - the gap error: the fraction of a step a closing gap spent closed
 //!   without force (energy.rs).
 //!
+//! With a rest speed ([`crate::impact::ImpactSettings::rest_speed`]) the
+//! impact ends as soon as no contact approaches faster than it and none
+//! stores the energy to rebound faster (docs/model.md §9).
+//!
 //! A step whose error exceeds the tolerance is taken again with
 //! h · clamp(0.9/√err, 0.1, 0.9); an accepted one grows by
 //! clamp(0.9/√err, 0.2, 5), from what a landing let it take.
@@ -47,6 +51,7 @@ impl ImpulseStepper {
         self.load(bodies, contacts);
         self.elapsed = 0.0;
         self.e0_hold = settings.e0_hold;
+        self.rest_speed = settings.rest_speed;
         out.kinetic_energy_before = bodies.iter().map(Body::kinetic_energy).sum();
         out.steps = 0;
         out.rejected_steps = 0;
@@ -80,6 +85,9 @@ impl ImpulseStepper {
         out: &mut ImpactOutcome,
     ) -> Result<StopReason, ImpactError> {
         loop {
+            if self.at_rest() {
+                return Ok(StopReason::AtRest);
+            }
             match self.step(h) {
                 Step::Done => return Ok(StopReason::Released),
                 Step::Advanced { .. } => {
@@ -111,6 +119,9 @@ impl ImpulseStepper {
         let h_min = p0 * 1e-15;
         let mut attempts = 0usize;
         loop {
+            if self.at_rest() {
+                return Ok(StopReason::AtRest);
+            }
             attempts += 1;
             if attempts > max_steps {
                 return Err(ImpactError::StepLimit { steps: out.steps });
@@ -219,4 +230,21 @@ fn next_step(h: f64, length: f64, error: f64, (h_min, p0): (f64, f64)) -> f64 {
     };
     let base = if length < h { length.max(0.1 * h) } else { h };
     (base * grow).clamp(h_min, p0)
+}
+
+impl ImpulseStepper {
+    /// Whether a rest speed is set and every contact approaches slower than
+    /// it and stores too little energy to rebound faster: √(2 e² E W_nn)
+    /// below it, e² E being what the contact gives back (energy.rs).
+    fn at_rest(&self) -> bool {
+        let rest = self.rest_speed;
+        rest > 0.0
+            && self.rows.iter().zip(&self.state).all(|(row, s)| {
+                !row.movable
+                    || (-row.normal_rate(&self.velocity) <= rest
+                        && (s.held
+                            || 2.0 * row.restitution * row.restitution * s.energy * row.w_nn
+                                <= rest * rest))
+            })
+    }
 }

@@ -37,6 +37,10 @@ pub(crate) struct ImpulseStepper {
     ///
     /// [`ImpactSettings::e0_hold`]: super::super::ImpactSettings::e0_hold
     pub(super) e0_hold: bool,
+    /// See [`ImpactSettings::rest_speed`] (m/s; 0: never before its end).
+    ///
+    /// [`ImpactSettings::rest_speed`]: super::super::ImpactSettings::rest_speed
+    pub(super) rest_speed: f64,
     /// Adaptive mode: state saved before a trial step, restored on rejection.
     pub(super) saved_velocity: Vec<[f64; 3]>,
     pub(super) saved_state: Vec<ContactState>,
