@@ -163,3 +163,44 @@ fn the_ideal_row_at_60_hz_is_close_to_the_reference_and_far_closer_than_native()
         "f32 {f32_} against f64 {f64_}"
     );
 }
+
+/// A ball (r = 0.02 m, 1 kg, e = 0.5) released at rest `drop` m above the
+/// ground, stepped at 1/60 s with the default 1/240 s sub-steps.
+fn slow_landing(drop: f64) -> Scene {
+    toml::from_str(&format!(
+        "duration = 0.3\n[solver]\ndt = {DT}\nlength_unit = 0.02\n\
+         [[materials]]\nname = \"m\"\nstiffness = 1e9\nrestitution = 0.5\n\
+         [ground]\ny = 0.0\nmaterial = \"m\"\n\
+         [[bodies]]\nshape = \"ball\"\nradius = 0.02\nposition = [0.0, {}]\nmass = 1.0\nmaterial = \"m\"\n",
+        0.02 + drop
+    ))
+    .unwrap()
+}
+
+#[test]
+fn a_slow_landing_in_a_sub_stepped_frame_is_an_impact() {
+    // Landing at about √(2 g · 2 mm) ≈ 0.2 m/s: slower than 2|g|Δt of the
+    // 1/60 s frame (0.33 m/s), faster than 2|g|h of its 1/240 s sub-steps
+    // (0.08 m/s), the approach a resting contact picks up in one Rapier
+    // step being |g|h. The frame is cut into sub-steps around the landing,
+    // so it is topple's impact: for one contact with the ground the
+    // energetic coefficient gives back e² of the kinetic energy. Left to
+    // Rapier (the threshold of the whole frame) it would stop dead.
+    for precision in [Precision::F64, Precision::F32] {
+        let out = run(&slow_landing(0.002), Engine::Rapier, precision);
+        let first = out.impacts.first().unwrap_or_else(|| {
+            panic!("{precision:?}: the landing was left to Rapier")
+        });
+        let r = first.report;
+        assert!(
+            (0.15..0.25).contains(&r.approach_speed),
+            "{precision:?}: approach {} m/s",
+            r.approach_speed
+        );
+        let ratio = r.kinetic_energy_after / r.kinetic_energy_before;
+        assert!(
+            (ratio - 0.25).abs() < 1e-3,
+            "{precision:?}: energy ratio {ratio}, closed form e² = 0.25"
+        );
+    }
+}
