@@ -10,7 +10,7 @@
 //!
 //! | setting | used in the step |
 //! | --- | --- |
-//! | impact threshold | max(`min_approach_speed` · L, 2 \|g\| Δt): 2 \|g\| Δt is twice the approach a resting contact picks up in one Rapier step, so a stack at rest has no impacts; Δt is the step, or the sub-step while a step is cut into sub-steps |
+//! | impact threshold | max(`min_approach_speed` · L, 2 \|g\| Δt): 2 \|g\| Δt is the approach a resting contact picks up in one step, so a stack at rest has no impacts |
 //! | closed tolerance | max(`patch.closed_tolerance` · L, 64 ε · max(L, 1)) |
 //! | flat tolerance | max(`patch.flat_tolerance` · L, 64 ε · max(L, 1)) |
 //! | shortest patch | `patch.min_patch_length` · L |
@@ -32,10 +32,14 @@ pub(crate) fn effective(
     gravity: Vector,
     params: &IntegrationParameters,
 ) -> ToppleSettings {
-    let l = length_unit(params);
+    let finite = |x: f64| if x.is_finite() { x } else { 0.0 };
+    let l = f64::from(params.length_unit);
+    let l = if l.is_finite() && l > 0.0 { l } else { 1.0 };
+    let g = finite(f64::from(gravity.length()));
+    let dt = finite(f64::from(params.dt)).max(0.0);
     let floor = 64.0 * f64::from(Real::EPSILON) * l.max(1.0);
     ToppleSettings {
-        min_approach_speed: threshold(s, gravity, params, f64::from(params.dt)),
+        min_approach_speed: (s.min_approach_speed * l).max(2.0 * g * dt),
         patch: PatchRule {
             closed_tolerance: (s.patch.closed_tolerance * l).max(floor),
             flat_tolerance: (s.patch.flat_tolerance * l).max(floor),
@@ -43,31 +47,5 @@ pub(crate) fn effective(
             ..s.patch
         },
         ..*s
-    }
-}
-
-/// The impact threshold (world units/s) of one Rapier step of `h` (s) in
-/// such a world: max(`min_approach_speed` · L, 2 |g| h). A resting contact
-/// picks up |g| h of approach in a Rapier step of h, so with the threshold
-/// twice that a stack at rest has no impacts; a frame cut into sub-steps
-/// has the sub-step's threshold (`ToppleRapier::step_parts`).
-pub(crate) fn threshold(
-    s: &ToppleSettings,
-    gravity: Vector,
-    params: &IntegrationParameters,
-    h: f64,
-) -> f64 {
-    let finite = |x: f64| if x.is_finite() { x } else { 0.0 };
-    let g = finite(f64::from(gravity.length()));
-    (s.min_approach_speed * length_unit(params)).max(2.0 * g * finite(h).max(0.0))
-}
-
-/// The world's length unit, 1 if it is not a positive number.
-fn length_unit(params: &IntegrationParameters) -> f64 {
-    let l = f64::from(params.length_unit);
-    if l.is_finite() && l > 0.0 {
-        l
-    } else {
-        1.0
     }
 }

@@ -170,9 +170,7 @@ impl ToppleRapier {
 
     /// The settings of the last step in the world's units: the impact
     /// threshold and tolerances derived from its length unit, gravity and
-    /// step (docs/bevy.md, "Settings follow the scene"); the threshold is
-    /// that of the last Rapier step taken (of a sub-step while the step was
-    /// cut into sub-steps).
+    /// step (docs/bevy.md, "Settings follow the scene").
     pub fn step_settings(&self) -> &ToppleSettings {
         &self.effective
     }
@@ -347,11 +345,6 @@ impl ToppleRapier {
                 }
             };
             params.dt = end - now;
-            // the threshold of the Rapier step about to be taken: of the
-            // sub-step while the step is cut into sub-steps (the approach a
-            // resting contact picks up is that of one Rapier step)
-            let rapier_step = f64::from(params.dt).max(f64::from(dt) / n as f64);
-            self.set_threshold(parts.gravity, &params, rapier_step);
             self.stats.rapier_steps += 1;
             let hooks = ChainedHooks {
                 topple: &self.hooks,
@@ -414,14 +407,6 @@ impl ToppleRapier {
         self.hooks.min_approach_speed = self.effective.min_approach_speed;
         self.hooks.stand_aside = false;
         self.pass.work_left = self.settings.fallback.max_work;
-    }
-
-    /// The impact threshold of a Rapier step of `h` (s), for the hook and
-    /// the pass ([`scale::threshold`]).
-    fn set_threshold(&mut self, gravity: Vector, params: &IntegrationParameters, h: f64) {
-        let t = scale::threshold(&self.settings, gravity, params, h);
-        self.effective.min_approach_speed = t;
-        self.hooks.min_approach_speed = t;
     }
 
     /// After a step: the notices of colliders left to Rapier, once each.
