@@ -9,7 +9,8 @@ use topple::rapier::f64::build;
 use topple::rapier::scene::{load_scene, Engine, Scene, WorkBudget};
 
 fn pile() -> Scene {
-    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/scenes/pile-boxes.toml");
+    let path =
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/scenes/pile-boxes.toml");
     load_scene(&path).unwrap()
 }
 
@@ -43,7 +44,11 @@ fn step_work(scene: &Scene, seconds: f64) -> (Vec<(u64, u64)>, u64) {
             let p = rb.translation();
             assert!(p.x.is_finite() && p.y.is_finite(), "{name} is NaN");
             // box half-diagonal 0.141 m: a centre below 0.05 m is through the floor
-            assert!(p.y > 0.05 || rb.is_fixed(), "{name} went through the floor: y {}", p.y);
+            assert!(
+                p.y > 0.05 || rb.is_fixed(),
+                "{name} went through the floor: y {}",
+                p.y
+            );
         }
     }
     (out, sw.topple.stats().budget_spent)
@@ -71,7 +76,10 @@ fn the_default_budget_bounds_every_step_of_a_pile() {
     for (k, &(work, from_reports)) in held.iter().enumerate() {
         assert!(work <= budget, "step {k}: work {work} > budget {budget}");
         // accepted steps only: at most the work that also counts rejected ones
-        assert!(from_reports <= work, "step {k}: reports {from_reports} > work {work}");
+        assert!(
+            from_reports <= work,
+            "step {k}: reports {from_reports} > work {work}"
+        );
     }
     assert!(spent > 0, "no step ran out of its budget");
 }
