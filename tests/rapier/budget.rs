@@ -20,7 +20,7 @@ fn pile() -> Scene {
 /// against NaN and the ground.
 fn step_work(scene: &Scene, seconds: f64) -> (Vec<(u64, u64)>, u64) {
     let mut sw = build(scene, Engine::Rapier).unwrap();
-    let steps = (seconds / f64::from(sw.world.integration_parameters.dt)).round() as usize;
+    let steps = (seconds / sw.world.integration_parameters.dt).round() as usize;
     let mut out = Vec::with_capacity(steps);
     for _ in 0..steps {
         let before = sw.topple.stats().work;
