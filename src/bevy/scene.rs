@@ -138,16 +138,12 @@ impl<'a> SceneSpawn<'a> {
         }
     }
 
-    /// topple's settings of the scene (per length unit, as `topple scene`)
-    /// with the default work budget of a game ([`ToppleSettings`]) unless
-    /// the scene sets `max_work`.
+    /// topple's settings of the scene (per length unit, as `topple scene`),
+    /// with the scene's work budget (by default a game's bounded step,
+    /// [`crate::rapier::scene::WorkBudget`]).
     pub fn topple_settings(&self) -> ToppleSettings {
         let length = f64::from(self.integration_parameters().length_unit);
-        let mut s = topple_settings(&self.scene.solver, length);
-        if self.scene.solver.max_work.is_none() {
-            s.fallback.max_work = ToppleSettings::default().fallback.max_work;
-        }
-        s
+        topple_settings(&self.scene.solver, length)
     }
 
     /// Spawns the scene: the ground, the bodies (a row's blocks asleep but

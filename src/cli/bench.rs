@@ -41,7 +41,7 @@ use super::chain::{row_spec, RowArgs};
 use topple::domino::{ChainReport, RowSpec};
 use topple::engines::{RapierRow, ReferenceRow, RowEngine};
 use topple::impact::StepControl;
-use topple::rapier::scene::{Engine, SolverSpec};
+use topple::rapier::scene::{Engine, SolverSpec, WorkBudget};
 use topple::rapier::Precision;
 use topple::reference::{Integrator, Settings};
 
@@ -253,6 +253,8 @@ fn execute_with(
             impulse_step,
             tolerance,
             max_group_hops: Some(args.window),
+            // an accuracy run: every impact to its end, no step budget
+            max_work: WorkBudget::Unbounded,
             ..Default::default()
         },
         max_time: args.max_time,

@@ -8,7 +8,7 @@ use anyhow::Context;
 use topple::domino::{Ground, Preset, RowParams, RowSpec};
 use topple::engines::{RapierRow, RowEngine};
 use topple::impact::StepControl;
-use topple::rapier::scene::{Engine, SolverSpec};
+use topple::rapier::scene::{Engine, SolverSpec, WorkBudget};
 use topple::reference::{snapshot_png, snapshot_svg, Integrator, Settings};
 use topple::theory::{Geometry, Model, Outcome};
 use topple::validate::{self, EngineKind, InputError, Naming, RunBudget};
@@ -380,6 +380,8 @@ fn run_rapier(args: &Args, row: &RowSpec, engine: Engine) -> anyhow::Result<()> 
             tolerance: args.tolerance,
             max_group_hops: Some(args.window),
             rest_fraction: args.rest_fraction,
+            // an accuracy run: every impact to its end, no step budget
+            max_work: WorkBudget::Unbounded,
             ..Default::default()
         },
         max_time: args.max_time,

@@ -16,7 +16,7 @@ pub mod chain;
 mod hooks;
 #[path = "adapter/motion.rs"]
 mod motion;
-#[path = "adapter/pass.rs"]
+#[path = "adapter/pass/mod.rs"]
 mod pass;
 #[path = "adapter/scale.rs"]
 mod scale;

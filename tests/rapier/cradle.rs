@@ -17,7 +17,7 @@ const V0: f64 = 1.0; // m/s, striking speed
 /// the chain by 2.4·10⁻³ V₀, at 10⁻⁶ by 2.2·10⁻⁴ V₀).
 fn scene(n: usize) -> Scene {
     let mut s = format!(
-        "duration = 0.005\ngravity = [0.0, 0.0]\n[solver]\ndt = 1e-4\nlength_unit = 0.1\nimpulse_step = 1e-4\n\
+        "duration = 0.005\ngravity = [0.0, 0.0]\n[solver]\nmax_work = \"none\"\ndt = 1e-4\nlength_unit = 0.1\nimpulse_step = 1e-4\n\
          [[materials]]\nname = \"steel\"\nstiffness = {K}\nrestitution = 1.0\n"
     );
     for i in 0..n {

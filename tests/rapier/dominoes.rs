@@ -19,7 +19,7 @@ const DT: f64 = 1e-3;
 
 fn ideal_row(spacing: f64, n: usize) -> Scene {
     toml::from_str(&format!(
-        "duration = 5.0\n[solver]\ndt = {DT}\n\
+        "duration = 5.0\n[solver]\nmax_work = \"none\"\ndt = {DT}\n\
          [row]\npreset = \"T\"\nn = {n}\nspacing = {spacing}\npush = 1.0\nideal = true\n\
          ground = \"no-slip\"\n"
     ))

@@ -20,7 +20,7 @@ const MU_S: f64 = 0.35;
 
 fn scene(y: f64, angle: f64) -> Scene {
     toml::from_str(&format!(
-        "duration = 0.5\n[solver]\ndt = 1e-4\nlength_unit = 0.05\nimpulse_step = 1e-4\n\
+        "duration = 0.5\n[solver]\nmax_work = \"none\"\ndt = 1e-4\nlength_unit = 0.05\nimpulse_step = 1e-4\n\
          [[materials]]\nname = \"wood\"\nstiffness = {K}\nrestitution = {E}\nfriction = {MU}\n\
          stick_friction = {MU_S}\n[ground]\ny = 0.0\nmaterial = \"wood\"\n\
          [[bodies]]\nshape = \"box\"\nsize = [{W}, {H}]\nposition = [0.0, {y}]\nangle = {angle}\n\

@@ -23,7 +23,7 @@ fn run(scene: &Scene, engine: Engine, precision: Precision) -> SceneOutput {
 fn two_balls(v: f64, t_hit: f64, e: f64, steps: usize) -> Scene {
     let gap = v * t_hit;
     toml::from_str(&format!(
-        "duration = {}\ngravity = [0.0, 0.0]\n[solver]\ndt = {DT}\nlength_unit = 0.1\n\
+        "duration = {}\ngravity = [0.0, 0.0]\n[solver]\nmax_work = \"none\"\ndt = {DT}\nlength_unit = 0.1\n\
          [[materials]]\nname = \"m\"\nstiffness = 1e9\nrestitution = {e}\n\
          [[bodies]]\nshape = \"ball\"\nradius = 0.05\nposition = [0.0, 0.0]\nvelocity = [{v}, 0.0]\nmass = 1.0\nmaterial = \"m\"\n\
          [[bodies]]\nshape = \"ball\"\nradius = 0.05\nposition = [{}, 0.0]\nmass = 1.0\nmaterial = \"m\"\n",
@@ -73,7 +73,7 @@ fn an_impact_inside_a_step_ends_as_the_same_impact_at_a_step_boundary() {
 /// Five touching boxes (0.1 m, 1 kg), e = 1, no gravity; the first at 1 m/s.
 fn box_cradle() -> Scene {
     let mut s = format!(
-        "duration = {DT}\ngravity = [0.0, 0.0]\n[solver]\ndt = {DT}\nlength_unit = 0.1\n\
+        "duration = {DT}\ngravity = [0.0, 0.0]\n[solver]\nmax_work = \"none\"\ndt = {DT}\nlength_unit = 0.1\n\
          [[materials]]\nname = \"steel\"\nstiffness = 2.3e10\nrestitution = 1.0\n"
     );
     for i in 0..5 {
@@ -122,7 +122,7 @@ fn a_cradle_of_boxes_keeps_momentum_and_energy_in_one_game_step() {
 #[test]
 fn the_ideal_row_at_60_hz_is_close_to_the_reference_and_far_closer_than_native() {
     use topple::domino::{Preset, RowSpec};
-    use topple::rapier::scene::{run_row, SolverSpec};
+    use topple::rapier::scene::{run_row, SolverSpec, WorkBudget};
     let p = Preset::T.params().ideal();
     let row = RowSpec::new(p, 0.45 * p.block.height, 40, 1.0);
     let reference = topple::reference::run(&row, &topple::reference::Settings::default())
@@ -133,6 +133,8 @@ fn the_ideal_row_at_60_hz_is_close_to_the_reference_and_far_closer_than_native()
     let solver = SolverSpec {
         dt: DT,
         max_group_hops: Some(2),
+        // an accuracy run against the reference: every impact to its end
+        max_work: WorkBudget::Unbounded,
         ..SolverSpec::default()
     };
     let speed = |engine, precision| {

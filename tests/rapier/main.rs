@@ -3,6 +3,7 @@
 //! One test binary per layer (so each links the crate once); each file below
 //! was a test binary of its own and keeps its tests and tolerances.
 
+mod budget;
 mod costs;
 mod cradle;
 mod determinism;

@@ -5,7 +5,7 @@
 
 use topple::domino::{Preset, RowSpec};
 use topple::rapier::scene::run_row;
-use topple::rapier::scene::{Engine, SolverSpec};
+use topple::rapier::scene::{Engine, SolverSpec, WorkBudget};
 use topple::rapier::Precision;
 use topple::reference::{Integrator, Settings};
 
@@ -34,6 +34,8 @@ fn compare(spacing_ratio: f64, n: usize) {
     let solver = SolverSpec {
         dt: 2e-4,
         max_group_hops: Some(8),
+        // an accuracy run against the reference: every impact to its end
+        max_work: WorkBudget::Unbounded,
         ..SolverSpec::default()
     };
     let topple = run_row(

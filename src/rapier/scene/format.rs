@@ -104,10 +104,90 @@ pub struct SolverSpec {
     pub max_substep: Option<f64>,
     /// Gap (m) at or below which a contact point is closed.
     pub closed_tolerance: f64,
-    /// Work budget of one step: LZB impulse steps times contact points,
-    /// shared by the step's impacts ([`crate::coupling::FallbackPolicy::max_work`]);
-    /// default none (every impact runs to its end).
-    pub max_work: Option<u64>,
+    /// Work budget of one step, shared by the step's impacts
+    /// ([`WorkBudget`]): by default a game's bounded step,
+    /// [`crate::coupling::ToppleSettings::DEFAULT_STEP_WORK`]; `"none"`
+    /// runs every impact to its end (accuracy runs).
+    pub max_work: WorkBudget,
+}
+
+/// The work budget of one Rapier step for the impacts in it: LZB impulse
+/// steps (accepted and rejected) times each impact's contact points
+/// ([`crate::coupling::FallbackPolicy::max_work`]). Counted in work, not in
+/// time, so that a run gives the same bits on any machine and under any
+/// load. Once a step's budget is spent, the impact that ran out is finished
+/// by the fallback policy (the held retry, at the latest a plastic solve:
+/// the group's contacts end the impact closing, e = 0, no energy created)
+/// and the rest of the step is native Rapier (docs/bevy.md, "Bounded
+/// frames"). In TOML: a number, or `"none"`.
+///
+/// ```
+/// use topple::coupling::ToppleSettings;
+/// use topple::rapier::scene::{SolverSpec, WorkBudget};
+/// let s: SolverSpec = toml::from_str("").unwrap();
+/// assert_eq!(s.max_work.max_work(), Some(ToppleSettings::DEFAULT_STEP_WORK));
+/// let s: SolverSpec = toml::from_str("max_work = 20000").unwrap();
+/// assert_eq!(s.max_work, WorkBudget::Work(20_000));
+/// let s: SolverSpec = toml::from_str(r#"max_work = "none""#).unwrap();
+/// assert_eq!(s.max_work, WorkBudget::Unbounded);
+/// assert!(toml::from_str::<SolverSpec>(r#"max_work = "lots""#).is_err());
+/// ```
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(try_from = "BudgetText", into = "BudgetText")]
+pub enum WorkBudget {
+    /// At most this much work per step.
+    Work(u64),
+    /// No bound: every impact runs to its end however long it takes (the
+    /// researcher's runs and the CLI's accuracy runs).
+    Unbounded,
+}
+
+impl Default for WorkBudget {
+    /// A game's bounded step, [`crate::coupling::ToppleSettings::DEFAULT_STEP_WORK`].
+    fn default() -> Self {
+        WorkBudget::Work(crate::coupling::ToppleSettings::DEFAULT_STEP_WORK)
+    }
+}
+
+impl WorkBudget {
+    /// As [`crate::coupling::FallbackPolicy::max_work`] takes it (`None`:
+    /// unbounded).
+    pub fn max_work(self) -> Option<u64> {
+        match self {
+            WorkBudget::Work(w) => Some(w),
+            WorkBudget::Unbounded => None,
+        }
+    }
+}
+
+/// How a [`WorkBudget`] is written: a number or the word `"none"`.
+#[derive(Serialize, Deserialize)]
+#[serde(untagged)]
+enum BudgetText {
+    Work(u64),
+    Word(String),
+}
+
+impl TryFrom<BudgetText> for WorkBudget {
+    type Error = String;
+    fn try_from(t: BudgetText) -> Result<Self, String> {
+        match t {
+            BudgetText::Work(w) => Ok(WorkBudget::Work(w)),
+            BudgetText::Word(w) if w == "none" => Ok(WorkBudget::Unbounded),
+            BudgetText::Word(w) => Err(format!(
+                "max_work = \"{w}\": a number of work units or \"none\""
+            )),
+        }
+    }
+}
+
+impl From<WorkBudget> for BudgetText {
+    fn from(b: WorkBudget) -> Self {
+        match b {
+            WorkBudget::Work(w) => BudgetText::Work(w),
+            WorkBudget::Unbounded => BudgetText::Word("none".into()),
+        }
+    }
 }
 
 impl Default for SolverSpec {
@@ -127,7 +207,7 @@ impl Default for SolverSpec {
             max_group_hops: None,
             max_substep: None,
             closed_tolerance: 1e-9,
-            max_work: None,
+            max_work: WorkBudget::default(),
         }
     }
 }

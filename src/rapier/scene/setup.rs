@@ -68,14 +68,18 @@ pub(crate) fn pair_material(l: &PairLaw) -> PairMaterial {
 /// settings are per length unit ([`crate::rapier`], "Units"), so lengths and
 /// speeds are divided by it here. The impact threshold is the scene's
 /// `min_approach_speed`, by default 10⁻³ m/s, and never below 2|g|Δt of the
-/// world's gravity and step (the adapter's floor). No work budget: a scene runs every impact to
-/// its end unless it sets `max_work`.
+/// world's gravity and step (the adapter's floor). The work budget of a
+/// step is the scene's `max_work`, by default a game's bounded step
+/// ([`super::WorkBudget`]); `max_work = "none"` runs every impact to its end.
 ///
 /// ```
-/// use topple::rapier::scene::{topple_settings, SolverSpec};
+/// use topple::coupling::ToppleSettings;
+/// use topple::rapier::scene::{topple_settings, SolverSpec, WorkBudget};
 /// let s = topple_settings(&SolverSpec::default(), 0.08);
 /// assert!((s.min_approach_speed * 0.08 - 1e-3).abs() < 1e-15);
-/// assert_eq!(s.fallback.max_work, None);
+/// assert_eq!(s.fallback.max_work, Some(ToppleSettings::DEFAULT_STEP_WORK));
+/// let exact = SolverSpec { max_work: WorkBudget::Unbounded, ..SolverSpec::default() };
+/// assert_eq!(topple_settings(&exact, 0.08).fallback.max_work, None);
 /// ```
 pub fn topple_settings(s: &SolverSpec, length_unit: f64) -> ToppleSettings {
     let l = if length_unit.is_finite() && length_unit > 0.0 {
@@ -101,7 +105,7 @@ pub fn topple_settings(s: &SolverSpec, length_unit: f64) -> ToppleSettings {
             .max_group_hops
             .or(ToppleSettings::default().max_group_hops),
         fallback: FallbackPolicy {
-            max_work: s.max_work,
+            max_work: s.max_work.max_work(),
             ..FallbackPolicy::default()
         },
         max_splits: s.max_splits.unwrap_or(ToppleSettings::default().max_splits),
