@@ -114,8 +114,7 @@ pub fn frame_budget(c: &SceneCombo) -> Option<u64> {
 pub fn within_native(c: &SceneCombo, o: &SceneObservation) -> bool {
     !c.engine.is_baseline()
         && o.native.is_some_and(|(pen, through)| {
-            (o.penetration_excess > tolerance::PENETRATION
-                && o.penetration_excess <= pen.max(tolerance::PENETRATION))
+            (o.penetration_excess > tolerance::PENETRATION && o.penetration <= pen)
                 || (o.through_ground.is_some() && through)
         })
 }
@@ -132,13 +131,16 @@ pub fn scene_violations(c: &SceneCombo, o: &SceneObservation) -> Vec<Violation> 
         ),
         (Kind::EnergyGain, a.energy_gain, ENERGY_GAIN),
         (Kind::Impulses, a.consistency, IMPULSES),
-        // beyond the tolerance, and for topple worse than native on the
+        // beyond the tolerance, and for topple deeper than native on the
         // same scene
         (
             Kind::Penetration,
-            o.penetration_excess,
-            o.native
-                .map_or(PENETRATION, |(pen, _)| pen.max(PENETRATION)),
+            if o.native.is_some_and(|(pen, _)| o.penetration <= pen) {
+                0.0
+            } else {
+                o.penetration_excess
+            },
+            PENETRATION,
         ),
         (
             Kind::ThroughGround,
@@ -426,7 +428,7 @@ pub fn scene_table(spec: &SceneSpec, r: &SceneResult) -> String {
             Kind::EnergyGain => format!("{:.0e}", tolerance::ENERGY_GAIN),
             Kind::Impulses => format!("{:.0e}", tolerance::IMPULSES),
             Kind::Penetration => format!(
-                "{} of the least width beyond one step's closing, and for topple worse than native",
+                "{} of the least width beyond one step's closing, and for topple deeper than native",
                 tolerance::PENETRATION
             ),
             Kind::ThroughGround => "centre below the ground unless one step's closing reaches it, and for topple not in native".into(),
