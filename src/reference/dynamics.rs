@@ -103,6 +103,8 @@ pub(crate) struct Dynamics {
     // buffers of `relaxed_forces`
     relax_rows: Vec<RelaxRow>,
     relax_acc: Vec<[f64; 3]>,
+    /// The forces [F_n, F_t] of `relaxed_forces`, kept for its caller.
+    relax_forces: Vec<[f64; 2]>,
 }
 
 /// One candidate contact in the relaxation of [`Dynamics::relaxed_forces`]:
@@ -208,6 +210,20 @@ fn span(u: &Unknown) -> (usize, usize) {
 }
 
 impl Dynamics {
+    /// The buffer for [`Dynamics::relaxed_forces`]' output, emptied; give
+    /// it back with [`Dynamics::keep_relax_forces`] (no allocation per
+    /// call once it has grown).
+    pub(crate) fn take_relax_forces(&mut self) -> Vec<[f64; 2]> {
+        let mut v = std::mem::take(&mut self.relax_forces);
+        v.clear();
+        v
+    }
+
+    /// Keeps `forces` as the buffer of the next [`Dynamics::take_relax_forces`].
+    pub(crate) fn keep_relax_forces(&mut self, forces: Vec<[f64; 2]>) {
+        self.relax_forces = forces;
+    }
+
     /// Assembles A = J M⁻¹ Cᵀ (+ reg · diag) of the current unknowns into the
     /// band (rhs untouched except resized) and returns false if nothing to do.
     fn assemble(&mut self, rc: &RowConst) {

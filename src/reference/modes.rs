@@ -247,13 +247,14 @@ pub(crate) fn select(
             size += 1;
         }
         if small && size > 0 {
-            let opts: Vec<([Option<Mode>; 4], usize)> = set[..size]
-                .iter()
-                .map(|&ci| options(rc, &candidates[ci], tol))
-                .collect();
+            let mut opts = [([None; 4], 1usize); 4];
+            for (o, &ci) in opts.iter_mut().zip(&set[..size]) {
+                *o = options(rc, &candidates[ci], tol);
+            }
+            let opts = &opts[..size];
             let combos: usize = opts.iter().map(|o| o.1).product();
             for mut code in 0..combos {
-                for (&ci, (o, n)) in set[..size].iter().zip(&opts) {
+                for (&ci, (o, n)) in set[..size].iter().zip(opts) {
                     state[ci] = o[code % n];
                     code /= n;
                 }
@@ -268,7 +269,7 @@ pub(crate) fn select(
     // The relaxation's forces as a mode: pressing where F_n > 0, sticking
     // inside the cone, sliding against F_t on its edge (along the slip
     // where the contact slips).
-    let mut forces = Vec::with_capacity(candidates.len());
+    let mut forces = dyn_.take_relax_forces();
     dyn_.relaxed_forces(
         rc,
         view,
@@ -296,6 +297,7 @@ pub(crate) fn select(
             Some(Mode::Frictionless)
         };
     }
+    dyn_.keep_relax_forces(forces);
     match assess(dyn_, rc, view, candidates, state, out, tol) {
         None => return false,
         Some(a) if a.worst.is_none() => return true,

@@ -107,6 +107,12 @@ pub struct Settings {
     /// Stop after this much wall-clock time (s), keeping what was measured
     /// (the report's `stopped_early` is then true); default: no limit.
     pub wall_time_limit: Option<f64>,
+    /// Stop after this many accepted integration steps, keeping what was
+    /// measured (`stopped_early` is then true): a bound on a run's work
+    /// that, unlike [`Settings::wall_time_limit`], ends a run at the same
+    /// point on an idle and a loaded machine; default: no limit.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub max_steps: Option<usize>,
     /// Stop at this time (s); default: 40 t̄ per block.
     pub t_max: Option<f64>,
     /// Blocks (1-based) whose θ and θ̇ are recorded.
@@ -135,6 +141,7 @@ impl Default for Settings {
             stop_at_last_hit: true,
             after_last_hit: 0.0,
             wall_time_limit: None,
+            max_steps: None,
             t_max: None,
             series_blocks: Vec::new(),
             series_interval: 0.0,

@@ -174,3 +174,76 @@ fn scene_draws_stay_in_their_ranges_and_rerun_to_the_same_bits() {
     assert!(o.error.is_none() && o.frames > 0, "{o:?}");
     assert_eq!(o.repeat_hash, Some(o.hash));
 }
+
+#[test]
+fn the_quick_scene_sweep_covers_every_kind_shape_build_unit_and_time_step() {
+    use topple::rapier::scene::ShapeKind;
+    use topple::rapier::Precision;
+    use topple::stress::scene::{SceneEngine, SceneKind, SceneSpec};
+    let spec = SceneSpec::quick(1);
+    let combos: Vec<_> = (0..spec.scenes).map(|i| spec.draw(i)).collect();
+    for kind in SceneKind::ALL {
+        for engine in SceneEngine::ALL {
+            // every kind with every engine, in the low and the high half of
+            // the unit range (1–10, 10–100 units/m) and of the time-step
+            // range (1/240–1/85 s, 1/85–1/30 s)
+            for (low_unit, low_dt) in [(true, true), (true, false), (false, true), (false, false)] {
+                let split = 8f64.sqrt() / 240.0;
+                assert!(
+                    combos.iter().any(|c| c.kind == kind
+                        && c.engine == engine
+                        && (c.unit < 10.0) == low_unit
+                        && (c.scene.solver.dt < split) == low_dt),
+                    "{kind:?} {engine:?} low unit {low_unit} low dt {low_dt}"
+                );
+            }
+        }
+        // native Rapier in both builds
+        for p in [Precision::F64, Precision::F32] {
+            assert!(combos
+                .iter()
+                .any(|c| c.kind == kind && c.engine == SceneEngine::Native && c.precision == p));
+        }
+    }
+    for shape in [ShapeKind::Box, ShapeKind::Ball] {
+        assert!(combos.iter().flat_map(|c| &c.scene.bodies).any(
+            |b| !b.fixed && std::mem::discriminant(&b.shape) == std::mem::discriminant(&shape)
+        ));
+    }
+    // every scene carries a game's frame budget
+    assert!(combos
+        .iter()
+        .all(|c| c.scene.solver.max_work
+            == Some(topple::coupling::ToppleSettings::DEFAULT_STEP_WORK)));
+}
+
+#[test]
+fn a_scene_frame_stays_within_its_budget_and_f32_impulses_rebuild_the_velocities() {
+    // scene 16 of the old quick sweep's seed: an f32 stack with masses of
+    // 10 g to 35 kg; before the adapter made its contact normals unit in
+    // f64 the audit saw velocities 6.4e-4 of the speed scale off the
+    // impulses (the f32 normal's length error times the gross impulse on
+    // the 10 g body)
+    use topple::rapier::Precision;
+    use topple::stress::scene::{run_scene_combo, scene_violations, SceneSpec};
+    let spec = SceneSpec::quick(1);
+    let mut checked = 0;
+    for i in [1, 4, 7] {
+        let c = spec.draw(i);
+        assert_eq!(c.precision, Precision::F32);
+        let o = run_scene_combo(&c, 60.0);
+        let budget = c.scene.solver.max_work.unwrap();
+        assert!(
+            o.worst_frame_work <= budget,
+            "{} > {budget}",
+            o.worst_frame_work
+        );
+        assert!(o.audit.consistency < 1e-6, "{:?}", o.audit);
+        assert!(o.audit.energy_gain <= 1e-9);
+        checked += o.audit.impacts;
+        // the check sees what the run saw
+        let v = scene_violations(&c, &o);
+        assert!(v.iter().all(|v| v.kind != topple::stress::Kind::Impulses));
+    }
+    assert!(checked > 0, "some impacts were checked");
+}

@@ -62,14 +62,19 @@ fn heel_contacts_run_a_long_small_spacing_row() {
     agree_with_the_row_without_heels(&row, &with, 0.01);
 }
 
-/// Runs `row` with heel contacts under a 120 s wall-clock limit and checks
-/// that the wave reached its last block.
+/// Runs `row` with heel contacts under a bound of 40,000 integration steps
+/// and checks that the wave reached its last block. The stall guard is on
+/// work, not wall time, so that a loaded machine cannot fail it: Domino X
+/// at s/h 0.18 with 30 blocks takes 10,636 steps to its last hit
+/// (`topple chain --preset x --spacing-ratio 0.18 --n 30 --heel-contacts`);
+/// a run whose events repeat at one instant takes steps without
+/// advancing and meets the bound.
 fn run_to_the_end_with_heels(row: &RowSpec) -> ChainReport {
     let with = run(
         row,
         &Settings {
             heel_contacts: true,
-            wall_time_limit: Some(120.0),
+            max_steps: Some(40_000),
             ..Default::default()
         },
     )
@@ -125,7 +130,9 @@ fn watched(row: &RowSpec) -> (RowWatch, ChainReport, Looks) {
     let t_end = 1.5;
     let settings = Settings {
         heel_contacts: true,
-        wall_time_limit: Some(120.0),
+        // the stall guard on work (see `run_to_the_end_with_heels`): Domino
+        // X at s/h 0.52 takes 7,624 steps to the last hit of 20 blocks
+        max_steps: Some(40_000),
         t_max: Some(t_end),
         snapshot_times: (1..)
             .map(|k| k as f64 * 2e-3)
@@ -216,4 +223,23 @@ fn combos_2765_and_2800_of_the_full_sweep_run_clean() {
         assert!(o.hits >= 3, "combo {index}: {} hits", o.hits);
         assert!(!o.over_budget, "combo {index}");
     }
+}
+
+/// `Settings::max_steps` stops a run after that many accepted steps and
+/// says so, whatever the machine's load.
+#[test]
+fn a_step_bound_stops_a_run_where_it_says() {
+    let p = Preset::X.params();
+    let row = RowSpec::new(p, 0.52 * p.block.height, 12, 1.0);
+    let bounded = run(
+        &row,
+        &Settings {
+            max_steps: Some(300),
+            ..Default::default()
+        },
+    )
+    .unwrap();
+    assert_eq!(bounded.steps, 300);
+    assert!(bounded.report.stopped_early);
+    assert!(bounded.report.hit_times.len() < row.n);
 }

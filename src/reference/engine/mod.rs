@@ -300,6 +300,10 @@ pub fn run_with_progress(
         {
             break;
         }
+        if settings.max_steps.is_some_and(|m| e.steps >= m) {
+            stopped_early = true;
+            break;
+        }
         if let Some(limit) = settings.wall_time_limit {
             if start.elapsed().as_secs_f64() > limit {
                 stopped_early = true;

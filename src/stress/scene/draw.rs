@@ -3,6 +3,7 @@
 //! from metres to pixels, at any time step from 1/240 to 1/30 s.
 
 use super::super::combo::SplitMix64;
+use crate::coupling::ToppleSettings;
 use crate::rapier::scene::{
     BodySpec, Engine, GroundSpec, MaterialSpec, Scene, ShapeKind, SolverSpec,
 };
@@ -175,17 +176,24 @@ impl SceneCombo {
 pub fn draw_scene(seed: u64, index: usize, n_lo: usize, n_hi: usize, duration: f64) -> SceneCombo {
     let mut g = SplitMix64::new(seed ^ (index as u64).wrapping_mul(0x9FB2_1C65_1E98_DF25));
     g.next_u64();
-    let engine = SceneEngine::ALL[index % SceneEngine::ALL.len()];
-    let kind = g.pick(&SceneKind::ALL);
+    // stratified, so that any 36 consecutive scenes hold every engine,
+    // kind, half of the unit range and half of the time-step range
+    // together: engine fastest, then kind, unit half, dt half
+    let engine = SceneEngine::ALL[index % 3];
+    let kind = SceneKind::ALL[(index / 3) % 3];
+    let (unit_half, dt_half) = (((index / 9) % 2) as f64, ((index / 18) % 2) as f64);
     let precision = match engine {
         SceneEngine::RapierF64 => Precision::F64,
         SceneEngine::RapierF32 => Precision::F32,
-        SceneEngine::Native => g.pick(&[Precision::F64, Precision::F32]),
+        // with the kind, (index / 3) % 6: every kind in both builds
+        SceneEngine::Native => [Precision::F64, Precision::F32][(index / 3) % 2],
     };
-    // metres to pixels at 100 px/m, log-uniform
-    let unit = 10f64.powf(g.range(0.0, 2.0));
-    // 1/240 s to 1/30 s, log-uniform
-    let dt = 8f64.powf(g.range(0.0, 1.0)) / 240.0;
+    // metres to pixels at 100 px/m, log-uniform within its half (1 to 10
+    // or 10 to 100 units per metre)
+    let unit = 10f64.powf(unit_half + g.range(0.0, 1.0));
+    // 1/240 s to 1/30 s, log-uniform within its half (1/240 to 1/85 s or
+    // 1/85 to 1/30 s)
+    let dt = 8f64.powf(0.5 * (dt_half + g.range(0.0, 1.0))) / 240.0;
     let n = n_lo + (g.next_u64() % (n_hi - n_lo + 1) as u64) as usize;
     let materials = draw_materials(&mut g);
     let names: Vec<String> = materials.iter().map(|m| m.name.clone()).collect();
@@ -238,6 +246,9 @@ pub fn draw_scene(seed: u64, index: usize, n_lo: usize, n_hi: usize, duration: f
             // what a game sets: its length unit (bevy_rapier's
             // pixels_per_meter); everything else at the defaults
             length_unit: Some(unit * base),
+            // a game's frame budget: the impacts of one step share the
+            // work the Bevy plugin gives a step by default
+            max_work: Some(ToppleSettings::DEFAULT_STEP_WORK),
             ..SolverSpec::default()
         },
         materials,

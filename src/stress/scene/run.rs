@@ -20,10 +20,31 @@ pub struct SceneObservation {
     pub penetration: f64,
     /// Where and when the largest overlap was.
     pub penetration_at: String,
-    /// A body whose centre went below the ground's top face: "bN at t".
+    /// Largest overlap beyond one step's closing, over the smaller body's
+    /// least width: (depth − Δt (ŝ_a + ŝ_b)) / w, where ŝ is the fastest a
+    /// body has moved so far (|v| + |ω| R, R its bounding radius) and a
+    /// body against the ground or a wall counts alone. What the scene
+    /// family checks ([`super::tolerance::PENETRATION`]).
+    pub penetration_excess: f64,
+    /// Where and when the largest excess was.
+    pub penetration_excess_at: String,
+    /// A body whose centre went below the ground's top face although one
+    /// step's closing Δt ŝ could not take it there (ŝ Δt at most half its
+    /// least width): "bN at t".
     pub through_ground: Option<String>,
-    /// Largest impact work of one frame: Σ over the frame's impacts of
-    /// impulse steps × contact points (the unit of the adapter's budget).
+    /// Bodies whose centre went below the ground when one step's closing
+    /// could take it there (tunnelling without continuous collision
+    /// detection; reported, not counted).
+    pub tunnelled: usize,
+    /// The same scene with native Rapier (a topple scene only): its largest
+    /// overlap over the least width (`penetration`, without allowance: the
+    /// allowance follows each run's own speeds) and whether a body went
+    /// through the ground.
+    pub native: Option<(f64, bool)>,
+    /// Largest impact work of one frame: Σ over the frame's impact attempts
+    /// of impulse steps (accepted and rejected) × contact points, the unit
+    /// of the adapter's budget (`FallbackPolicy::max_work`): the adapter's
+    /// count, and at least the LZB steps the impact reports show.
     pub worst_frame_work: u64,
     /// Frames taken.
     pub frames: usize,
@@ -89,6 +110,22 @@ pub fn run_scene_combo(c: &SceneCombo, budget: f64) -> SceneObservation {
         seen.repeat_hash = (!again.over_budget).then_some(again.hash);
     }
     seen.wall = start.elapsed().as_secs_f64();
+    if c.rapier_engine() != Engine::RapierNative {
+        // the baseline on the same scene (its wall time is not the run's)
+        let frames = (c.scene.duration / c.scene.solver.dt).round() as usize;
+        let mut hooks = Hooks {
+            watch: true,
+            budget,
+            frames,
+            ..Hooks::default()
+        };
+        let native = match c.precision {
+            Precision::F64 => on_f64::run(&c.scene, Engine::RapierNative, &mut hooks),
+            Precision::F32 => on_f32::run(&c.scene, Engine::RapierNative, &mut hooks),
+        };
+        seen.native = (native.error.is_none())
+            .then_some((native.penetration, native.through_ground.is_some()));
+    }
     seen
 }
 
@@ -129,6 +166,14 @@ macro_rules! watcher_for {
                 f64::from(e.x.min(e.y))
             }
 
+            /// A bound on the distance of a collider's points from its
+            /// centre: its local box's half diagonal.
+            fn bounding_radius(sw: &SceneWorld, c: ColliderHandle) -> f64 {
+                let aabb = sw.world.colliders[c].shape().compute_local_aabb();
+                let e = aabb.extents();
+                0.5 * f64::from(e.x).hypot(f64::from(e.y))
+            }
+
             /// Runs `scene` with `engine` as `hooks` say.
             pub(crate) fn run(
                 scene: &Scene,
@@ -146,6 +191,11 @@ macro_rules! watcher_for {
                 let handles: Vec<(RigidBodyHandle, ColliderHandle)> =
                     sw.bodies.iter().map(|b| (b.1, b.2)).collect();
                 let sizes: Vec<f64> = handles.iter().map(|h| least_width(&sw, h.1)).collect();
+                let radii: Vec<f64> =
+                    handles.iter().map(|h| bounding_radius(&sw, h.1)).collect();
+                // the fastest each body has moved (|v| + |ω| R), from its start
+                let mut fastest = vec![0.0f64; handles.len()];
+                let dt = scene.solver.dt;
                 let ground_y = scene.ground.as_ref().map_or(f64::NEG_INFINITY, |g| g.y);
                 // the ground's collider: the one no scene body owns
                 let ground = sw
@@ -166,10 +216,21 @@ macro_rules! watcher_for {
                 let mut hash = Fnv::new();
                 for frame in 0..hooks.frames {
                     let t0 = Instant::now();
+                    let counted = sw.topple.stats().work;
                     let (work, impacts, fallbacks) = {
                         let reports = sw.step();
+                        // a bound from below, from the reports alone: the
+                        // impulse steps of the attempt each LZB or held
+                        // impact ended with (a plastic one reports sweeps)
                         let work: u64 = reports
                             .iter()
+                            .filter(|r| {
+                                matches!(
+                                    r.resolution,
+                                    crate::coupling::Resolution::Lzb
+                                        | crate::coupling::Resolution::Held
+                                )
+                            })
                             .map(|r| r.steps as u64 * r.contacts as u64)
                             .sum();
                         let fallbacks = reports
@@ -181,6 +242,9 @@ macro_rules! watcher_for {
                     seen.worst_frame_seconds =
                         seen.worst_frame_seconds.max(t0.elapsed().as_secs_f64());
                     seen.frames = frame + 1;
+                    // the adapter's count of every attempt's steps
+                    // (accepted and rejected) × contacts, the budget's unit
+                    let work = work.max(sw.topple.stats().work - counted);
                     seen.worst_frame_work = seen.worst_frame_work.max(work);
                     seen.impacts += impacts;
                     seen.fallbacks += fallbacks;
@@ -202,15 +266,34 @@ macro_rules! watcher_for {
                         for v in state {
                             hash.add(v);
                         }
-                        if hooks.watch && seen.through_ground.is_none() && state[1] < ground_y {
-                            seen.through_ground = Some(format!("b{} at t = {time:.3} s", k + 1));
+                        let speed = state[3].hypot(state[4]) + state[5].abs() * radii[k];
+                        if frame == 0 {
+                            let (v, w) = (initial[k].1, initial[k].2);
+                            let start = f64::from(v.x).hypot(f64::from(v.y))
+                                + f64::from(w).abs() * radii[k];
+                            fastest[k] = fastest[k].max(start);
+                        }
+                        fastest[k] = fastest[k].max(speed);
+                        if hooks.watch && state[1] < ground_y {
+                            if dt * fastest[k] > 0.5 * sizes[k] {
+                                seen.tunnelled += 1;
+                            } else if seen.through_ground.is_none() {
+                                seen.through_ground =
+                                    Some(format!("b{} at t = {time:.3} s", k + 1));
+                            }
                         }
                     }
                     if seen.non_finite {
                         break;
                     }
                     if hooks.watch {
-                        overlaps(&sw, &handles, &sizes, ground, time, &mut seen);
+                        let bodies = Bodies {
+                            handles: &handles,
+                            sizes: &sizes,
+                            closing: &fastest,
+                            dt,
+                        };
+                        overlaps(&sw, &bodies, ground, time, &mut seen);
                     }
                     if start.elapsed().as_secs_f64() > hooks.budget {
                         seen.over_budget = true;
@@ -231,26 +314,46 @@ macro_rules! watcher_for {
                 seen
             }
 
+            /// The scene's bodies as the overlap check needs them.
+            struct Bodies<'a> {
+                handles: &'a [(RigidBodyHandle, ColliderHandle)],
+                /// Least widths.
+                sizes: &'a [f64],
+                /// The fastest each body has moved so far (|v| + |ω| R).
+                closing: &'a [f64],
+                /// Time step (s).
+                dt: f64,
+            }
+
             /// Every pair of bodies whose boxes meet, and every body against
-            /// the ground: the deepest overlap over the smaller least width.
+            /// the ground: the deepest overlap over the smaller least width,
+            /// and the deepest beyond one step's closing.
             fn overlaps(
                 sw: &SceneWorld,
-                handles: &[(RigidBodyHandle, ColliderHandle)],
-                sizes: &[f64],
+                b: &Bodies,
                 ground: Option<ColliderHandle>,
                 time: f64,
                 seen: &mut SceneObservation,
             ) {
+                let (handles, sizes) = (b.handles, b.sizes);
                 let w = &sw.world;
                 let aabbs: Vec<_> = handles
                     .iter()
                     .map(|(_, col)| w.colliders[*col].compute_aabb())
                     .collect();
-                let mut note = |depth: f64, size: f64, what: String| {
+                let mut note = |depth: f64, size: f64, closing: f64, what: String| {
                     let d = depth / size;
                     if d > seen.penetration {
                         seen.penetration = d;
                         seen.penetration_at = format!("{what} at t = {time:.3} s");
+                    }
+                    let excess = (depth - b.dt * closing) / size;
+                    if excess > seen.penetration_excess {
+                        seen.penetration_excess = excess;
+                        seen.penetration_excess_at = format!(
+                            "{what} at t = {time:.3} s, {d:.3} deep, one step's closing {:.3}",
+                            b.dt * closing / size
+                        );
                     }
                 };
                 for i in 0..handles.len() {
@@ -263,6 +366,7 @@ macro_rules! watcher_for {
                             note(
                                 -gap,
                                 sizes[i].min(sizes[j]),
+                                b.closing[i] + b.closing[j],
                                 format!("b{}/b{}", i + 1, j + 1),
                             );
                         }
@@ -270,7 +374,7 @@ macro_rules! watcher_for {
                     if let Some(gr) = ground {
                         let gap = signed_gap(&w.bodies, &w.colliders, gr, handles[i].1);
                         if gap < 0.0 {
-                            note(-gap, sizes[i], format!("b{}/ground", i + 1));
+                            note(-gap, sizes[i], b.closing[i], format!("b{}/ground", i + 1));
                         }
                     }
                 }

@@ -10,7 +10,7 @@ use crate::coupling::{
 };
 use crate::impact::{Body, ContactMaterial};
 
-use super::{body_index, closed_tolerance, dynamic_parent, v2, ImpactPass, World, NO_SLOT};
+use super::{body_index, closed_tolerance, dynamic_parent, unit, v2, ImpactPass, World, NO_SLOT};
 
 impl ImpactPass {
     /// Adds a dynamic body to the group being built, at its state of time `t`.
@@ -217,7 +217,7 @@ impl ImpactPass {
             // points of a sub-shape are in its own frame
             let p1 = m.subshape_pos1().map_or(pa, |sub| pa * *sub);
             let p2 = m.subshape_pos2().map_or(pb, |sub| pb * *sub);
-            let normal = v2(p1.transform_vector(m.local_n1).normalize());
+            let normal = unit(v2(p1.transform_vector(m.local_n1).normalize()));
             self.points.clear();
             for p in &m.points {
                 let mid = 0.5 * (p1.transform_point(p.local_p1) + p2.transform_point(p.local_p2));
