@@ -211,10 +211,8 @@ fn the_quick_scene_sweep_covers_every_kind_shape_build_unit_and_time_step() {
         ));
     }
     // every scene carries a game's frame budget
-    assert!(combos
-        .iter()
-        .all(|c| c.scene.solver.max_work
-            == Some(topple::coupling::ToppleSettings::DEFAULT_STEP_WORK)));
+    assert!(combos.iter().all(|c| c.scene.solver.max_work.max_work()
+        == Some(topple::coupling::ToppleSettings::DEFAULT_STEP_WORK)));
 }
 
 #[test]
@@ -232,7 +230,7 @@ fn a_scene_frame_stays_within_its_budget_and_f32_impulses_rebuild_the_velocities
         let c = spec.draw(i);
         assert_eq!(c.precision, Precision::F32);
         let o = run_scene_combo(&c, 60.0);
-        let budget = c.scene.solver.max_work.unwrap();
+        let budget = c.scene.solver.max_work.max_work().unwrap();
         assert!(
             o.worst_frame_work <= budget,
             "{} > {budget}",

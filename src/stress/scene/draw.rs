@@ -5,7 +5,7 @@
 use super::super::combo::SplitMix64;
 use crate::coupling::ToppleSettings;
 use crate::rapier::scene::{
-    BodySpec, Engine, GroundSpec, MaterialSpec, Scene, ShapeKind, SolverSpec,
+    BodySpec, Engine, GroundSpec, MaterialSpec, Scene, ShapeKind, SolverSpec, WorkBudget,
 };
 use crate::rapier::Precision;
 
@@ -248,7 +248,7 @@ pub fn draw_scene(seed: u64, index: usize, n_lo: usize, n_hi: usize, duration: f
             length_unit: Some(unit * base),
             // a game's frame budget: the impacts of one step share the
             // work the Bevy plugin gives a step by default
-            max_work: Some(ToppleSettings::DEFAULT_STEP_WORK),
+            max_work: WorkBudget::Work(ToppleSettings::DEFAULT_STEP_WORK),
             ..SolverSpec::default()
         },
         materials,

@@ -106,7 +106,7 @@ pub mod tolerance {
 /// The frame budget a scene carries: its `max_work` (impulse steps ×
 /// contact points per step), `None` if it sets none (then unchecked).
 pub fn frame_budget(c: &SceneCombo) -> Option<u64> {
-    c.scene.solver.max_work
+    c.scene.solver.max_work.max_work()
 }
 
 /// A topple run beyond the overlap tolerance or through the ground, but no
