@@ -23,7 +23,10 @@ pub fn plot_svg(
     rows: &[SweepRow],
 ) -> Result<(), TheoryError> {
     draw(path, thickness_ratio, models, rows)
-        .map_err(|e| TheoryError::Output(format!("plot {}: {e}", path.display())))
+        .map_err(|e| TheoryError::Output {
+            path: path.to_path_buf(),
+            message: format!("plot: {e}"),
+        })
 }
 
 fn draw(
