@@ -33,7 +33,11 @@ impl std::str::FromStr for Preset {
             "X" => Ok(Preset::X),
             "T" => Ok(Preset::T),
             "P" => Ok(Preset::P),
-            _ => Err(InputError::new("preset", format!("{s:?}"), "X, T or P (either case)")),
+            _ => Err(InputError::new(
+                "preset",
+                format!("{s:?}"),
+                "X, T or P (either case)",
+            )),
         }
     }
 }
@@ -153,7 +157,11 @@ impl RowParams {
         ];
         for (name, v) in pos {
             if !(v.is_finite() && v > 0.0) {
-                return Err(InputError::new(name, fmt_value(v), format!("finite and {name} > 0")));
+                return Err(InputError::new(
+                    name,
+                    fmt_value(v),
+                    format!("finite and {name} > 0"),
+                ));
             }
         }
         let nonneg = [
@@ -165,7 +173,11 @@ impl RowParams {
         ];
         for (name, v) in nonneg {
             if !(v.is_finite() && v >= 0.0) {
-                return Err(InputError::new(name, fmt_value(v), format!("finite and {name} ≥ 0")));
+                return Err(InputError::new(
+                    name,
+                    fmt_value(v),
+                    format!("finite and {name} ≥ 0"),
+                ));
             }
         }
         check_range("e1", self.e1, 0.0, 1.0)?;
@@ -178,7 +190,10 @@ impl RowParams {
                 return Err(InputError::new(
                     stick,
                     fmt_value(v),
-                    format!("{stick} ≥ {slide} = {} (sticking ≥ sliding friction)", fmt_value(m)),
+                    format!(
+                        "{stick} ≥ {slide} = {} (sticking ≥ sliding friction)",
+                        fmt_value(m)
+                    ),
                 ));
             }
         }

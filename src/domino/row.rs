@@ -90,7 +90,11 @@ impl RowSpec {
             return Err(InputError::new("n", self.n, "n ≥ 2"));
         }
         if !(self.push.is_finite() && self.push > 0.0) {
-            return Err(InputError::new("push", fmt_value(self.push), "finite and push > 0"));
+            return Err(InputError::new(
+                "push",
+                fmt_value(self.push),
+                "finite and push > 0",
+            ));
         }
         Ok(())
     }

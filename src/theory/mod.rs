@@ -75,8 +75,8 @@ pub use plot::plot_svg;
 pub use sweep::{sweep, write_csv, SweepRow};
 pub use threshold::{min_spacing, SpacingBracket};
 
-use serde::Serialize;
 use crate::input::InputError;
+use serde::Serialize;
 
 /// A model of the wave.
 ///

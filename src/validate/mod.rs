@@ -26,8 +26,8 @@ pub(crate) mod overlap;
 pub mod row;
 mod syntax;
 
-pub use crate::input::{check_count, check_open_low, check_range, InputError};
 pub(crate) use crate::input::fmt_value;
+pub use crate::input::{check_count, check_open_low, check_range, InputError};
 pub use impact::{impact, impact_stepping};
 pub use memory::{available_memory, check_memory, memory_estimate, EngineKind};
 #[cfg(all(feature = "f32", feature = "f64"))]
@@ -36,4 +36,3 @@ pub use row::{row, Naming, RunBudget};
 #[cfg(feature = "scene-files")]
 pub use syntax::parse_toml;
 pub use syntax::SyntaxError;
-

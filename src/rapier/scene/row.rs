@@ -5,10 +5,10 @@
 use crate::domino::{Ground, Preset, RowParams, RowSpec as DominoRow};
 
 use super::error::{SceneError, SceneResult};
-use crate::input::InputError;
 use super::format::{
     BodySpec, GroundSpec, MaterialSpec, PairLaw, PairSpec, RowSection, Scene, ShapeKind,
 };
+use crate::input::InputError;
 
 /// Friction coefficient that stands for "never slips" in Rapier's smooth
 /// phase on a [`Ground::NoSlip`] row (inside topple's impacts the friction
