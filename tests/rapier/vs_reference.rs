@@ -5,7 +5,7 @@
 
 use topple::domino::{Preset, RowSpec};
 use topple::rapier::scene::run_row;
-use topple::rapier::scene::{ImpactResponse, SolverSpec};
+use topple::rapier::scene::{Engine, SolverSpec};
 use topple::rapier::Precision;
 use topple::reference::{Integrator, Settings};
 
@@ -38,7 +38,7 @@ fn compare(spacing_ratio: f64, n: usize) {
     };
     let topple = run_row(
         &row,
-        ImpactResponse::Topple,
+        Engine::Rapier,
         Precision::F64,
         solver.clone(),
         20.0,
@@ -47,7 +47,7 @@ fn compare(spacing_ratio: f64, n: usize) {
     .unwrap();
     let native = run_row(
         &row,
-        ImpactResponse::Native,
+        Engine::RapierNative,
         Precision::F64,
         solver,
         20.0,

@@ -4,7 +4,7 @@
 
 use super::super::combo::SplitMix64;
 use crate::rapier::scene::{
-    BodySpec, GroundSpec, ImpactResponse, MaterialSpec, Scene, ShapeKind, SolverSpec,
+    BodySpec, Engine, GroundSpec, MaterialSpec, Scene, ShapeKind, SolverSpec,
 };
 use crate::rapier::Precision;
 
@@ -156,10 +156,10 @@ pub struct SceneCombo {
 
 impl SceneCombo {
     /// The topple engine of this combination (native for the baseline).
-    pub fn rapier_engine(&self) -> ImpactResponse {
+    pub fn rapier_engine(&self) -> Engine {
         match self.engine {
-            SceneEngine::Native => ImpactResponse::Native,
-            _ => ImpactResponse::Topple,
+            SceneEngine::Native => Engine::RapierNative,
+            _ => Engine::Rapier,
         }
     }
 

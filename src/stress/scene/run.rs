@@ -6,7 +6,7 @@ use std::time::Instant;
 
 use super::draw::SceneCombo;
 use crate::impact::audit::{self, AuditSummary};
-use crate::rapier::scene::{ImpactResponse, Scene};
+use crate::rapier::scene::{Engine, Scene};
 use crate::rapier::Precision;
 
 /// What one scene run shows, measured from the bodies' states and the
@@ -116,7 +116,7 @@ macro_rules! watcher_for {
             use std::time::Instant;
 
             use super::{Fnv, Hooks, SceneObservation};
-            use crate::rapier::scene::{ImpactResponse, Scene};
+            use crate::rapier::scene::{Engine, Scene};
             use crate::rapier::$adapter::{build, signed_gap, SceneWorld};
             use crate::$backend::parry::bounding_volume::BoundingVolume;
             use crate::$backend::prelude::{ColliderHandle, RigidBodyHandle};
@@ -132,7 +132,7 @@ macro_rules! watcher_for {
             /// Runs `scene` with `engine` as `hooks` say.
             pub(crate) fn run(
                 scene: &Scene,
-                engine: ImpactResponse,
+                engine: Engine,
                 hooks: &mut Hooks,
             ) -> SceneObservation {
                 let mut seen = SceneObservation::default();
@@ -286,7 +286,7 @@ watcher_for!(on_f32, f32, rapier2d);
 /// impact checked.
 pub(crate) fn run_with(
     scene: &Scene,
-    engine: ImpactResponse,
+    engine: Engine,
     precision: Precision,
     hooks: &mut Hooks,
 ) -> SceneObservation {
