@@ -7,6 +7,7 @@
 //!
 //! | layer | what it holds |
 //! | --- | --- |
+//! | [`input`] | the structured error of a bad value: field, value and allowed range |
 //! | [`atomic`] | files written whole or not at all (temporary name, then rename) |
 //! | [`impact`] | the LZB resolver: bodies + contacts in, post-impact velocities out |
 //! | [`coupling`] | engine-agnostic: materials, λ-point patches, impact groups, the fallback policy |
@@ -44,6 +45,7 @@ pub mod coupling;
 pub mod domino;
 pub mod engines;
 pub mod impact;
+pub mod input;
 mod par;
 pub mod rapier;
 pub mod reference;

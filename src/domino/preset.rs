@@ -3,6 +3,7 @@
 use serde::{Deserialize, Serialize};
 
 use super::{Block, Ground};
+use crate::input::{check_range, fmt_value, InputError};
 
 /// The three block types of Table 1.
 ///
@@ -24,7 +25,7 @@ pub enum Preset {
 }
 
 impl std::str::FromStr for Preset {
-    type Err = String;
+    type Err = InputError;
 
     /// "X", "T" or "P" (either case).
     fn from_str(s: &str) -> Result<Self, Self::Err> {
@@ -32,7 +33,11 @@ impl std::str::FromStr for Preset {
             "X" => Ok(Preset::X),
             "T" => Ok(Preset::T),
             "P" => Ok(Preset::P),
-            _ => Err(format!("unknown domino preset {s:?} (X, T or P)")),
+            _ => Err(InputError::new(
+                "preset",
+                format!("{s:?}"),
+                "X, T or P (either case)",
+            )),
         }
     }
 }
@@ -127,9 +132,19 @@ impl RowParams {
         (self.block.height / self.gravity).sqrt()
     }
 
-    /// Checks that every value is usable; returns a message naming the first
-    /// one that is not.
-    pub fn validate(&self) -> Result<(), String> {
+    /// Checks that every value is usable; the error names the first one
+    /// that is not (its field name in [`RowParams`] and [`Block`]), its value
+    /// and the allowed range.
+    ///
+    /// ```
+    /// use topple::domino::Preset;
+    /// let mut p = Preset::X.params();
+    /// p.e1 = 1.5;
+    /// let e = p.validate().unwrap_err();
+    /// assert_eq!((e.field.as_str(), e.value.as_str()), ("e1", "1.5"));
+    /// assert_eq!(e.to_string(), "e1 = 1.5: allowed 0 ≤ e1 ≤ 1");
+    /// ```
+    pub fn validate(&self) -> Result<(), InputError> {
         let b = &self.block;
         let pos = [
             ("height", b.height),
@@ -142,7 +157,11 @@ impl RowParams {
         ];
         for (name, v) in pos {
             if !(v.is_finite() && v > 0.0) {
-                return Err(format!("{name} must be finite and > 0 (got {v})"));
+                return Err(InputError::new(
+                    name,
+                    fmt_value(v),
+                    format!("finite and {name} > 0"),
+                ));
             }
         }
         let nonneg = [
@@ -154,22 +173,43 @@ impl RowParams {
         ];
         for (name, v) in nonneg {
             if !(v.is_finite() && v >= 0.0) {
-                return Err(format!("{name} must be finite and >= 0 (got {v})"));
+                return Err(InputError::new(
+                    name,
+                    fmt_value(v),
+                    format!("finite and {name} ≥ 0"),
+                ));
             }
         }
-        for (name, v) in [("e1", self.e1), ("e2", self.e2)] {
-            if !(0.0..=1.0).contains(&v) {
-                return Err(format!("{name} must be in [0, 1] (got {v})"));
+        check_range("e1", self.e1, 0.0, 1.0)?;
+        check_range("e2", self.e2, 0.0, 1.0)?;
+        for (stick, v, slide, m) in [
+            ("mu1_stick", self.mu1_stick, "mu1", self.mu1),
+            ("mu2_stick", self.mu2_stick, "mu2", self.mu2),
+        ] {
+            if v < m {
+                return Err(InputError::new(
+                    stick,
+                    fmt_value(v),
+                    format!(
+                        "{stick} ≥ {slide} = {} (sticking ≥ sliding friction)",
+                        fmt_value(m)
+                    ),
+                ));
             }
-        }
-        if self.mu1_stick < self.mu1 || self.mu2_stick < self.mu2 {
-            return Err("sticking friction must be >= sliding friction".into());
         }
         if self.lambda_points < 2 {
-            return Err("lambda must be >= 2 (the two bottom corners)".into());
+            return Err(InputError::new(
+                "lambda_points",
+                self.lambda_points,
+                "lambda_points ≥ 2 (the two bottom corners)",
+            ));
         }
         if b.thickness >= b.height {
-            return Err("thickness must be smaller than height".into());
+            return Err(InputError::new(
+                "thickness",
+                fmt_value(b.thickness),
+                format!("0 < thickness < height = {}", fmt_value(b.height)),
+            ));
         }
         Ok(())
     }

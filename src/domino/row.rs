@@ -3,6 +3,7 @@
 use serde::{Deserialize, Serialize};
 
 use super::RowParams;
+use crate::input::{fmt_value, InputError};
 
 /// A row of `n` identical blocks standing on the ground at gap `spacing` s (m),
 /// block 1 at the origin, the wave running towards +x; block 1 starts rotating
@@ -65,20 +66,35 @@ impl RowSpec {
         ([-omega * r[1], omega * r[0]], omega)
     }
 
-    /// Checks the row is usable.
-    pub fn validate(&self) -> Result<(), String> {
+    /// Checks the row is usable: its [`RowParams`] (see
+    /// [`RowParams::validate`]), then `spacing`, `n` and `push`; the error names
+    /// the field, its value and the allowed range.
+    ///
+    /// ```
+    /// use topple::domino::{Preset, RowSpec};
+    /// let p = Preset::X.params();
+    /// let e = RowSpec::new(p, 0.3 * p.block.height, 1, 1.0).validate().unwrap_err();
+    /// assert_eq!(e.to_string(), "n = 1: allowed n ≥ 2");
+    /// ```
+    pub fn validate(&self) -> Result<(), InputError> {
         self.params.validate()?;
-        if !(self.spacing.is_finite() && self.spacing > 0.0) {
-            return Err(format!("spacing must be > 0 (got {})", self.spacing));
-        }
-        if self.spacing >= self.params.block.height {
-            return Err("spacing must be smaller than the block height".into());
+        let h = self.params.block.height;
+        if !(self.spacing.is_finite() && self.spacing > 0.0 && self.spacing < h) {
+            return Err(InputError::new(
+                "spacing",
+                fmt_value(self.spacing),
+                format!("0 < spacing < height = {}", fmt_value(h)),
+            ));
         }
         if self.n < 2 {
-            return Err("a row needs at least 2 blocks".into());
+            return Err(InputError::new("n", self.n, "n ≥ 2"));
         }
         if !(self.push.is_finite() && self.push > 0.0) {
-            return Err(format!("push must be > 0 (got {})", self.push));
+            return Err(InputError::new(
+                "push",
+                fmt_value(self.push),
+                "finite and push > 0",
+            ));
         }
         Ok(())
     }

@@ -20,9 +20,10 @@ pub enum ImpactError {
         /// What is wrong.
         reason: String,
     },
-    /// The settings are unusable (step or tolerance not in (0, 1], zero step limit).
+    /// The settings are unusable (step or tolerance not in (0, 1], zero step
+    /// limit): the field, its value and the allowed range.
     #[error("settings: {0}")]
-    InvalidSettings(String),
+    InvalidSettings(crate::input::InputError),
     /// The impact did not end within `max_steps` steps, or stopped making
     /// progress (gaps closing without any point loading).
     #[error("impact did not end within {steps} steps (raise max_steps or the impulse step)")]

@@ -2,6 +2,7 @@
 //! panic or a silent wrong answer.
 
 use super::{Body, Contact, ImpactError, ImpactSettings, StepControl};
+use crate::input::{fmt_value, InputError};
 
 fn finite2(v: [f64; 2]) -> bool {
     v[0].is_finite() && v[1].is_finite()
@@ -88,33 +89,43 @@ pub(crate) fn check(
     match settings.step_control {
         StepControl::Fixed { impulse_step } => {
             if !(impulse_step > 0.0 && impulse_step <= 1.0) {
-                return Err(ImpactError::InvalidSettings(format!(
-                    "impulse_step {impulse_step} is not in (0, 1]"
+                return Err(ImpactError::InvalidSettings(InputError::new(
+                    "impulse_step",
+                    fmt_value(impulse_step),
+                    "0 < impulse_step ≤ 1",
                 )));
             }
         }
         StepControl::Adaptive { tolerance } | StepControl::AdaptiveImpulse { tolerance } => {
             if !(tolerance > 0.0 && tolerance < 1.0) {
-                return Err(ImpactError::InvalidSettings(format!(
-                    "tolerance {tolerance} is not in (0, 1)"
+                return Err(ImpactError::InvalidSettings(InputError::new(
+                    "tolerance",
+                    fmt_value(tolerance),
+                    "0 < tolerance < 1",
                 )));
             }
         }
     }
     if settings.fast_cycle.is_nan() || settings.fast_cycle < 0.0 {
-        return Err(ImpactError::InvalidSettings(format!(
-            "fast_cycle {} is not >= 0",
-            settings.fast_cycle
+        return Err(ImpactError::InvalidSettings(InputError::new(
+            "fast_cycle",
+            fmt_value(settings.fast_cycle),
+            "fast_cycle ≥ 0",
         )));
     }
     if !(settings.rest_speed >= 0.0 && settings.rest_speed.is_finite()) {
-        return Err(ImpactError::InvalidSettings(format!(
-            "rest_speed {} is not finite and >= 0",
-            settings.rest_speed
+        return Err(ImpactError::InvalidSettings(InputError::new(
+            "rest_speed",
+            fmt_value(settings.rest_speed),
+            "finite rest_speed ≥ 0",
         )));
     }
     if settings.max_steps == 0 {
-        return Err(ImpactError::InvalidSettings("max_steps is 0".into()));
+        return Err(ImpactError::InvalidSettings(InputError::new(
+            "max_steps",
+            0,
+            "max_steps ≥ 1",
+        )));
     }
     Ok(())
 }

@@ -8,6 +8,7 @@
 //! `m g h` and an angular velocity in units of √(g/h).
 
 use super::TheoryError;
+use crate::input::InputError;
 
 /// The shape of a row of identical blocks: thickness `d/h` and gap `s/h`.
 ///
@@ -33,13 +34,17 @@ impl Geometry {
     /// "no wave" (the falling block never reaches the next one).
     pub fn new(thickness_ratio: f64, spacing_ratio: f64) -> Result<Self, TheoryError> {
         if !(thickness_ratio.is_finite() && thickness_ratio > 0.0 && thickness_ratio < 1.0) {
-            return Err(TheoryError::InvalidParameter(format!(
-                "thickness ratio d/h must be a number in (0, 1), got {thickness_ratio}"
+            return Err(TheoryError::InvalidParameter(InputError::new(
+                "d/h",
+                thickness_ratio,
+                "0 < d/h < 1 (thickness ratio)",
             )));
         }
         if !(spacing_ratio.is_finite() && spacing_ratio > 0.0) {
-            return Err(TheoryError::InvalidParameter(format!(
-                "spacing ratio s/h must be a positive number, got {spacing_ratio}"
+            return Err(TheoryError::InvalidParameter(InputError::new(
+                "s/h",
+                spacing_ratio,
+                "finite and s/h > 0 (spacing ratio)",
             )));
         }
         Ok(Self {

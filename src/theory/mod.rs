@@ -75,6 +75,7 @@ pub use plot::plot_svg;
 pub use sweep::{sweep, write_csv, SweepRow};
 pub use threshold::{min_spacing, SpacingBracket};
 
+use crate::input::InputError;
 use serde::Serialize;
 
 /// A model of the wave.
@@ -129,14 +130,18 @@ impl Model {
     pub fn validate(&self) -> Result<(), TheoryError> {
         let mu = self.mu();
         if !(mu.is_finite() && mu >= 0.0) {
-            return Err(TheoryError::InvalidParameter(format!(
-                "friction coefficient mu must be a finite number >= 0, got {mu}"
+            return Err(TheoryError::InvalidParameter(InputError::new(
+                "mu",
+                mu,
+                "finite and mu ≥ 0 (friction coefficient)",
             )));
         }
         if let Model::Single { e, .. } = *self {
             if !(0.0..=1.0).contains(&e) {
-                return Err(TheoryError::InvalidParameter(format!(
-                    "coefficient of restitution e must be in [0, 1], got {e}"
+                return Err(TheoryError::InvalidParameter(InputError::new(
+                    "e",
+                    e,
+                    "0 ≤ e ≤ 1 (coefficient of restitution)",
                 )));
             }
         }

@@ -134,20 +134,37 @@ impl Outcome {
 /// ```
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
 pub enum TheoryError {
-    /// An argument is out of its range (the message says which and why).
+    /// An argument is out of its range: the argument, its value and the
+    /// allowed range.
     #[error("{0}")]
-    InvalidParameter(String),
+    InvalidParameter(#[from] crate::input::InputError),
     /// The parameters are valid but the model's assumptions break down there
     /// (the message says how), so it gives no answer.
     #[error("outside the model: {0}")]
     OutsideModel(String),
-    /// A numerical procedure did not reach its tolerance.
+    /// A numerical procedure did not reach its tolerance (the message says
+    /// which and how far it got).
     #[error("not converged: {0}")]
     NotConverged(String),
-    /// [`min_spacing`](super::min_spacing) found no step from "no wave" to "wave".
-    #[error("{0}")]
-    NoThreshold(String),
+    /// [`min_spacing`](super::min_spacing) found no step from "no wave" to
+    /// "wave" for s/h in (0, 1).
+    #[error("{}", match .wave_at {
+        Some(s) => format!("the {model} model has a wave already at s/h = {s}"),
+        None => format!("the {model} model has no wave for s/h in (0, 1)"),
+    })]
+    NoThreshold {
+        /// The model's name ([`Model::name`](super::Model::name)).
+        model: &'static str,
+        /// The smallest spacing ratio tried, if the wave runs there already;
+        /// `None` if no spacing ratio gives a wave.
+        wave_at: Option<f64>,
+    },
     /// Writing a table or a plot failed.
-    #[error("{0}")]
-    Output(String),
+    #[error("{}: {message}", .path.display())]
+    Output {
+        /// The file.
+        path: std::path::PathBuf,
+        /// What went wrong.
+        message: String,
+    },
 }

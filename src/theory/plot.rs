@@ -22,8 +22,10 @@ pub fn plot_svg(
     models: &[Model],
     rows: &[SweepRow],
 ) -> Result<(), TheoryError> {
-    draw(path, thickness_ratio, models, rows)
-        .map_err(|e| TheoryError::Output(format!("plot {}: {e}", path.display())))
+    draw(path, thickness_ratio, models, rows).map_err(|e| TheoryError::Output {
+        path: path.to_path_buf(),
+        message: format!("plot: {e}"),
+    })
 }
 
 fn draw(

@@ -2,6 +2,7 @@
 //! the first step from "no wave" to "wave".
 
 use super::{solve, Geometry, Model, Outcome, TheoryError};
+use crate::input::InputError;
 use serde::Serialize;
 
 /// Two spacings around the smallest spacing with a wave: the model has no wave
@@ -34,8 +35,10 @@ pub fn min_spacing(
     tolerance: f64,
 ) -> Result<SpacingBracket, TheoryError> {
     if !(tolerance.is_finite() && tolerance > 0.0) {
-        return Err(TheoryError::InvalidParameter(format!(
-            "tolerance must be a positive number, got {tolerance}"
+        return Err(TheoryError::InvalidParameter(InputError::new(
+            "tolerance",
+            tolerance,
+            "finite and tolerance > 0",
         )));
     }
     let has_wave = |s: f64| -> Result<bool, TheoryError> {
@@ -44,10 +47,10 @@ pub fn min_spacing(
     };
     let step = 1e-3;
     if has_wave(step)? {
-        return Err(TheoryError::NoThreshold(format!(
-            "the {} model has a wave already at s/h = {step}",
-            model.name()
-        )));
+        return Err(TheoryError::NoThreshold {
+            model: model.name(),
+            wave_at: Some(step),
+        });
     }
     let mut lo = step;
     for i in 2..1000 {
@@ -70,8 +73,8 @@ pub fn min_spacing(
         }
         lo = s;
     }
-    Err(TheoryError::NoThreshold(format!(
-        "the {} model has no wave for s/h in (0, 1)",
-        model.name()
-    )))
+    Err(TheoryError::NoThreshold {
+        model: model.name(),
+        wave_at: None,
+    })
 }

@@ -85,3 +85,23 @@ fn preset_names_ignore_case() {
     assert!(!bad.status.success());
     assert!(bad.stdout.is_empty());
 }
+
+/// `topple scene --engine X --json` names the engine as the command line
+/// does (the names a JSON report has always carried).
+#[test]
+fn the_scene_report_names_the_engine_as_the_command_line_does() {
+    let file = concat!(env!("CARGO_MANIFEST_DIR"), "/assets/scenes/cradle-3.toml");
+    for engine in ["rapier", "rapier-native"] {
+        let out = Command::new(env!("CARGO_BIN_EXE_topple"))
+            .args(["scene", file, "--engine", engine, "--json"])
+            .output()
+            .unwrap();
+        assert!(
+            out.status.success(),
+            "{engine}: {}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+        assert_eq!(v["engine"].as_str(), Some(engine), "{engine}");
+    }
+}

@@ -3,8 +3,9 @@
 //! both precisions, `topple paper`'s files and the stress sweep's table.
 //! Wall-clock times are the only values allowed to differ.
 
-use std::path::Path;
 use std::process::Command;
+
+use super::paper_files::{clean_paper, files, PAPER_ARGS};
 
 fn topple(args: &[&str], threads: usize) -> Vec<u8> {
     let out = Command::new(env!("CARGO_BIN_EXE_topple"))
@@ -62,47 +63,23 @@ fn the_rapier_plugin_repeats_its_bits_for_any_thread_count() {
     }
 }
 
-/// Every file of a directory, by name, as bytes. Subdirectories are skipped:
-/// `runs/` is the resume cache, whose records carry each run's wall time.
-fn files(dir: &Path) -> Vec<(String, Vec<u8>)> {
-    let mut v: Vec<(String, Vec<u8>)> = std::fs::read_dir(dir)
-        .unwrap()
-        .map(|e| e.unwrap().path())
-        .filter(|p| p.is_file())
-        .map(|p| {
-            (
-                p.file_name().unwrap().to_string_lossy().into_owned(),
-                std::fs::read(&p).unwrap(),
-            )
-        })
-        .collect();
-    v.sort();
-    v
-}
-
 #[test]
 fn paper_writes_the_same_files_for_any_thread_count() {
-    let root = std::env::temp_dir().join(format!("topple-determinism-{}", std::process::id()));
-    let mut outputs = Vec::new();
-    for threads in [1, 3] {
-        let dir = root.join(format!("t{threads}"));
-        let d = dir.to_str().unwrap();
-        topple(
-            &["paper", "--out", d, "--figs", "3,8", "--n", "10"],
-            threads,
-        );
-        outputs.push(files(&dir));
-    }
+    // one thread: the clean call the resume test compares against too
+    let one = &clean_paper().files;
+    let dir = std::env::temp_dir().join(format!("topple-determinism-{}", std::process::id()));
+    let d = dir.to_str().unwrap();
+    let mut args = vec!["paper", "--out", d];
+    args.extend_from_slice(&PAPER_ARGS);
+    topple(&args, 3);
+    let three = files(&dir);
     assert!(
-        outputs[0].len() >= 4,
+        one.len() >= 4,
         "{:?}",
-        outputs[0].iter().map(|f| &f.0).collect::<Vec<_>>()
+        one.iter().map(|f| &f.0).collect::<Vec<_>>()
     );
-    assert!(
-        outputs[0] == outputs[1],
-        "the files differ between 1 and 3 threads"
-    );
-    std::fs::remove_dir_all(&root).unwrap();
+    assert!(*one == three, "the files differ between 1 and 3 threads");
+    std::fs::remove_dir_all(&dir).unwrap();
 }
 
 #[test]

@@ -10,6 +10,7 @@ mod chain_theory;
 mod determinism;
 mod impact;
 mod malformed_input;
+mod paper_files;
 mod paper_resume;
 mod snapshots;
 mod theory;

@@ -6,7 +6,7 @@
 use std::path::Path;
 use std::process::{Command, Stdio};
 
-const ARGS: [&str; 4] = ["--figs", "3,8", "--n", "10"];
+use super::paper_files::{clean_paper, files as figures, saved_runs, PAPER_ARGS as ARGS};
 
 fn paper(out: &Path, resume: bool) -> String {
     let mut args = vec!["paper", "--out", out.to_str().unwrap()];
@@ -22,48 +22,19 @@ fn paper(out: &Path, resume: bool) -> String {
     String::from_utf8(o.stderr).unwrap()
 }
 
-/// The figure files (CSV, SVG) of a directory by name, as bytes.
-fn figures(dir: &Path) -> Vec<(String, Vec<u8>)> {
-    let mut v: Vec<(String, Vec<u8>)> = std::fs::read_dir(dir)
-        .unwrap()
-        .map(|e| e.unwrap().path())
-        .filter(|p| p.is_file())
-        .map(|p| {
-            (
-                p.file_name().unwrap().to_string_lossy().into_owned(),
-                std::fs::read(&p).unwrap(),
-            )
-        })
-        .collect();
-    v.sort();
-    v
-}
-
-/// The finished runs saved (not the temporary file of a write in flight).
-fn saved_runs(dir: &Path) -> Vec<std::path::PathBuf> {
-    match std::fs::read_dir(dir.join("runs")) {
-        Ok(r) => r
-            .map(|e| e.unwrap().path())
-            .filter(|p| !p.file_name().unwrap().to_string_lossy().starts_with('.'))
-            .collect(),
-        Err(_) => Vec::new(),
-    }
-}
-
 #[test]
 fn a_killed_paper_leaves_whole_files_and_resumes_to_the_same_figures() {
     let root = std::env::temp_dir().join(format!("topple-resume-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&root);
-    let clean = root.join("clean");
-    paper(&clean, false);
-    let want = figures(&clean);
+    let clean = clean_paper();
+    let want = &clean.files;
     assert_eq!(
         want.len(),
         4,
         "{:?}",
         want.iter().map(|f| &f.0).collect::<Vec<_>>()
     );
-    assert_eq!(saved_runs(&clean).len(), 8, "2 runs of Fig. 3, 6 of Fig. 8");
+    assert_eq!(clean.saved_runs, 8, "2 runs of Fig. 3, 6 of Fig. 8");
 
     // kill a second call once it has saved a run
     let cut = root.join("cut");
@@ -93,9 +64,8 @@ fn a_killed_paper_leaves_whole_files_and_resumes_to_the_same_figures() {
         stderr.contains(&format!("reused {done_before} of 8 runs")) || done_before == 0,
         "{stderr}"
     );
-    assert_eq!(
-        figures(&cut),
-        want,
+    assert!(
+        figures(&cut) == *want,
         "resumed figures differ from a clean call"
     );
 
@@ -106,6 +76,6 @@ fn a_killed_paper_leaves_whole_files_and_resumes_to_the_same_figures() {
     std::fs::write(first, text.replacen("\"push\":", "\"push\":9", 1)).unwrap();
     let stderr = paper(&cut, true);
     assert!(stderr.contains("reused 7 of 8 runs"), "{stderr}");
-    assert_eq!(figures(&cut), want);
+    assert!(figures(&cut) == *want);
     std::fs::remove_dir_all(&root).unwrap();
 }

@@ -11,19 +11,16 @@ fn topple(args: &[&str]) -> std::process::Output {
         .expect("run topple")
 }
 
+/// Arguments written on one line, split at spaces.
+fn split(args: &str) -> Vec<&str> {
+    args.split(' ').collect()
+}
+
 #[test]
 fn json_has_natural_speed() {
-    let out = topple(&[
-        "--model",
-        "extended",
-        "--mu",
-        "0.2",
-        "--thickness-ratio",
-        "0.12",
-        "--spacing-ratio",
-        "0.35",
-        "--json",
-    ]);
+    let out = topple(&split(
+        "--model extended --mu 0.2 --thickness-ratio 0.12 --spacing-ratio 0.35 --json",
+    ));
     assert!(
         out.status.success(),
         "{}",
@@ -45,19 +42,9 @@ fn json_has_natural_speed() {
     );
     assert_eq!(v["wave"], serde_json::Value::Bool(true));
 
-    let out = topple(&[
-        "--model",
-        "single",
-        "--mu",
-        "0",
-        "--e",
-        "0",
-        "--thickness-ratio",
-        "0.12",
-        "--spacing-ratio",
-        "0.1",
-        "--json",
-    ]);
+    let out = topple(&split(
+        "--model single --mu 0 --e 0 --thickness-ratio 0.12 --spacing-ratio 0.1 --json",
+    ));
     assert!(out.status.success());
     let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
     assert!(v["natural_speed"].is_null());
@@ -98,137 +85,27 @@ fn sweep_writes_csv_and_svg() {
 
 #[test]
 fn bad_arguments_fail_cleanly() {
-    let cases: &[&[&str]] = &[
-        &[
-            "--model",
-            "cooperative",
-            "--thickness-ratio",
-            "0.12",
-            "--spacing-ratio",
-            "abc",
-        ],
-        &[
-            "--model",
-            "cooperative",
-            "--thickness-ratio",
-            "-1",
-            "--spacing-ratio",
-            "0.3",
-        ],
-        &[
-            "--model",
-            "cooperative",
-            "--thickness-ratio",
-            "0.12",
-            "--spacing-ratio",
-            "-0.3",
-        ],
-        &[
-            "--model",
-            "cooperative",
-            "--thickness-ratio",
-            "NaN",
-            "--spacing-ratio",
-            "0.3",
-        ],
-        &[
-            "--model",
-            "cooperative",
-            "--thickness-ratio",
-            "0.12",
-            "--spacing-ratio",
-            "0.3",
-            "--mu",
-            "0.2",
-        ],
-        &[
-            "--model",
-            "extended",
-            "--thickness-ratio",
-            "0.12",
-            "--spacing-ratio",
-            "0.3",
-        ],
-        &[
-            "--model",
-            "extended",
-            "--thickness-ratio",
-            "0.12",
-            "--spacing-ratio",
-            "0.3",
-            "--mu",
-            "-1",
-        ],
-        &[
-            "--model",
-            "single",
-            "--thickness-ratio",
-            "0.12",
-            "--spacing-ratio",
-            "0.3",
-            "--mu",
-            "0.1",
-        ],
-        &[
-            "--model",
-            "single",
-            "--thickness-ratio",
-            "0.12",
-            "--spacing-ratio",
-            "0.3",
-            "--mu",
-            "0.1",
-            "--e",
-            "2",
-        ],
-        &[
-            "--model",
-            "bogus",
-            "--thickness-ratio",
-            "0.12",
-            "--spacing-ratio",
-            "0.3",
-        ],
-        &["--thickness-ratio", "0.12", "--spacing-ratio", "0.3"],
-        &[
-            "--thickness-ratio",
-            "0.12",
-            "--spacing-ratio",
-            "0.5:0.1:0.1",
-            "--mu",
-            "0.1",
-            "--e",
-            "0.5",
-        ],
-        &[
-            "--thickness-ratio",
-            "0.12",
-            "--spacing-ratio",
-            "0.1:0.5",
-            "--mu",
-            "0.1",
-            "--e",
-            "0.5",
-        ],
-        &[
-            "--thickness-ratio",
-            "0.12",
-            "--spacing-ratio",
-            "0.1:0.5:0",
-            "--mu",
-            "0.1",
-            "--e",
-            "0.5",
-        ],
-        &[
-            "--thickness-ratio",
-            "0.12",
-            "--spacing-ratio",
-            "0.1:0.5:0.1",
-        ],
+    // each case on one line, its arguments split at spaces
+    let cases = [
+        "--model cooperative --thickness-ratio 0.12 --spacing-ratio abc",
+        "--model cooperative --thickness-ratio -1 --spacing-ratio 0.3",
+        "--model cooperative --thickness-ratio 0.12 --spacing-ratio -0.3",
+        "--model cooperative --thickness-ratio NaN --spacing-ratio 0.3",
+        "--model cooperative --thickness-ratio 0.12 --spacing-ratio 0.3 --mu 0.2",
+        "--model extended --thickness-ratio 0.12 --spacing-ratio 0.3",
+        "--model extended --thickness-ratio 0.12 --spacing-ratio 0.3 --mu -1",
+        "--model single --thickness-ratio 0.12 --spacing-ratio 0.3 --mu 0.1",
+        "--model single --thickness-ratio 0.12 --spacing-ratio 0.3 --mu 0.1 --e 2",
+        "--model bogus --thickness-ratio 0.12 --spacing-ratio 0.3",
+        "--thickness-ratio 0.12 --spacing-ratio 0.3",
+        "--thickness-ratio 0.12 --spacing-ratio 0.5:0.1:0.1 --mu 0.1 --e 0.5",
+        "--thickness-ratio 0.12 --spacing-ratio 0.1:0.5 --mu 0.1 --e 0.5",
+        "--thickness-ratio 0.12 --spacing-ratio 0.1:0.5:0 --mu 0.1 --e 0.5",
+        "--thickness-ratio 0.12 --spacing-ratio 0.1:0.5:0.1",
     ];
-    for args in cases {
-        let out = topple(args);
+    for case in cases {
+        let args = split(case);
+        let out = topple(&args);
         let err = String::from_utf8_lossy(&out.stderr);
         assert!(!out.status.success(), "{args:?} succeeded");
         assert!(err.starts_with("error"), "{args:?}: {err}");

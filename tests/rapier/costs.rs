@@ -57,14 +57,17 @@ fn count_one() {
 unsafe impl GlobalAlloc for Counting {
     unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
         count_one();
-        System.alloc(layout)
+        // SAFETY: the caller's contract of `alloc`, passed on.
+        unsafe { System.alloc(layout) }
     }
     unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
-        System.dealloc(ptr, layout)
+        // SAFETY: the caller's contract of `dealloc`, passed on.
+        unsafe { System.dealloc(ptr, layout) }
     }
     unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
         count_one();
-        System.realloc(ptr, layout, new_size)
+        // SAFETY: the caller's contract of `realloc`, passed on.
+        unsafe { System.realloc(ptr, layout, new_size) }
     }
 }
 

@@ -2,7 +2,7 @@
 //! shape, no two bodies overlapping at the start (the errors name the field,
 //! the value and the range, as [`crate::validate`]'s).
 
-use super::{BodySpec, PairLaw, RowSpec, Scene, ShapeKind};
+use super::{BodySpec, PairLaw, RowSection, Scene, ShapeKind};
 use crate::domino::{Preset, RowParams, RowSpec as DominoRow};
 use crate::validate::overlap::{overlap, Placed};
 use crate::validate::{check_count, check_open_low, check_range, fmt_value, row, EngineKind};
@@ -217,7 +217,7 @@ fn no_overlap(shapes: &[Placed], ground: Option<f64>) -> Result<(), InputError> 
 
 /// The row of a scene: its preset and every override in the ranges of
 /// [`crate::validate::row()`], named by their scene keys.
-fn scene_row(r: &RowSpec, s: &Scene) -> Result<(), InputError> {
+fn scene_row(r: &RowSection, s: &Scene) -> Result<(), InputError> {
     let preset = match r.preset.to_ascii_uppercase().as_str() {
         "X" => Preset::X,
         "T" => Preset::T,

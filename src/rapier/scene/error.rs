@@ -1,21 +1,30 @@
 //! The error of building or running a scene.
 
+use crate::input::InputError;
+
 /// Why a scene could not be loaded, built or run. Its message is one line
-/// that names the field and the value at fault.
+/// that names the field and the value at fault; a value out of its range
+/// carries the structured [`InputError`] (field, value, allowed range).
 ///
 /// ```
-/// use topple::rapier::scene::{run_scene, Engine, RunOptions, Scene, SceneError};
-/// use topple::rapier::Precision;
+/// use topple::rapier::scene::{check_scene, Scene, SceneError};
 /// let scene: Scene = toml::from_str("duration = 1.0\n[solver]\ndt = 0.0").unwrap();
-/// let err = run_scene(&scene, Engine::Rapier, Precision::F64, RunOptions::default()).unwrap_err();
-/// assert!(matches!(err, SceneError::Invalid(_)));
-/// assert!(err.to_string().contains("dt"));
+/// let err = SceneError::from(check_scene(&scene).unwrap_err());
+/// let SceneError::Invalid(e) = &err else { panic!("{err}") };
+/// assert_eq!((e.field.as_str(), e.value.as_str()), ("solver.dt", "0"));
+/// assert!(err.to_string().starts_with("solver.dt = 0: allowed"));
 /// ```
 #[derive(Debug, thiserror::Error)]
 pub enum SceneError {
-    /// A value of the scene is out of its range or inconsistent.
+    /// A value of the scene is out of its range: the field, the value as
+    /// given and the allowed range.
     #[error("{0}")]
-    Invalid(String),
+    Invalid(#[from] InputError),
+    /// The scene names something it does not define or leaves out what a
+    /// shape needs (an unknown material, a box without `size`): the message
+    /// says which.
+    #[error("{0}")]
+    Inconsistent(String),
     /// A file could not be read or written.
     #[error("{path}: {source}")]
     Io {
@@ -39,9 +48,10 @@ pub enum SceneError {
 }
 
 impl SceneError {
-    /// An [`SceneError::Invalid`] with this message.
+    /// A [`SceneError::Inconsistent`] with this message (for a value out
+    /// of its range, use [`SceneError::Invalid`] with an [`InputError`]).
     pub fn invalid(message: impl Into<String>) -> Self {
-        SceneError::Invalid(message.into())
+        SceneError::Inconsistent(message.into())
     }
 }
 

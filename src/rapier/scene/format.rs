@@ -48,7 +48,7 @@ pub struct Scene {
     pub bodies: Vec<BodySpec>,
     /// A generated domino row (adds its blocks, materials, pair rules and ground).
     #[serde(default)]
-    pub row: Option<RowSpec>,
+    pub row: Option<RowSection>,
 }
 
 fn default_gravity() -> [f64; 2] {
@@ -343,11 +343,13 @@ pub struct BodySpec {
     pub material: String,
 }
 
-/// A domino row on the ground (paper Sec. 3): blocks standing at spacing s,
-/// the first pushed about its front bottom edge.
+/// A scene file's `[row]` section: a domino row on the ground (paper
+/// Sec. 3), blocks standing at spacing s, the first pushed about its front
+/// bottom edge. [`row_params`](super::row_params) turns it into the
+/// [`crate::domino::RowParams`] of a [`crate::domino::RowSpec`].
 #[derive(Clone, Debug, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
-pub struct RowSpec {
+pub struct RowSection {
     /// Table 1 preset: "X", "T" or "P".
     pub preset: String,
     /// Number of blocks.

@@ -22,8 +22,8 @@ mod setup;
 pub use check::check_scene;
 pub use error::{SceneError, SceneResult};
 pub use format::{
-    BodySpec, GroundSpec, MaterialSpec, PairLaw, PairSpec, RowOverrides, RowSpec, Scene, ShapeKind,
-    SolverSpec, WorkBudget,
+    BodySpec, GroundSpec, MaterialSpec, PairLaw, PairSpec, RowOverrides, RowSection, Scene,
+    ShapeKind, SolverSpec, WorkBudget,
 };
 pub use row::{expand_row, row_params, NO_SLIP_FRICTION};
 pub use run::{run_row, run_scene};

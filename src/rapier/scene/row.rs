@@ -6,8 +6,9 @@ use crate::domino::{Ground, Preset, RowParams, RowSpec as DominoRow};
 
 use super::error::{SceneError, SceneResult};
 use super::format::{
-    BodySpec, GroundSpec, MaterialSpec, PairLaw, PairSpec, RowSpec, Scene, ShapeKind,
+    BodySpec, GroundSpec, MaterialSpec, PairLaw, PairSpec, RowSection, Scene, ShapeKind,
 };
+use crate::input::InputError;
 
 /// Friction coefficient that stands for "never slips" in Rapier's smooth
 /// phase on a [`Ground::NoSlip`] row (inside topple's impacts the friction
@@ -22,17 +23,17 @@ pub const NO_SLIP_FRICTION: f64 = 1e3;
 /// and the block mass (the row's `mass`, else `density` × h × d).
 ///
 /// ```
-/// use topple::rapier::scene::{row_params, RowSpec};
-/// let row: RowSpec = toml::from_str("preset = \"T\"\nn = 3\nspacing = 0.3\nideal = true").unwrap();
+/// use topple::rapier::scene::{row_params, RowSection};
+/// let row: RowSection = toml::from_str("preset = \"T\"\nn = 3\nspacing = 0.3\nideal = true").unwrap();
 /// let p = row_params(&row, 9.81).unwrap();
 /// assert_eq!((p.mu1, p.e1, p.mu2), (0.0, 0.0, 0.9));
 /// assert_eq!(p.block.height, 0.08);
 /// ```
-pub fn row_params(row: &RowSpec, gravity: f64) -> SceneResult<RowParams> {
+pub fn row_params(row: &RowSection, gravity: f64) -> SceneResult<RowParams> {
     let mut p = row
         .preset
         .parse::<Preset>()
-        .map_err(SceneError::Invalid)?
+        .map_err(|e| SceneError::Invalid(InputError::new("row.preset", e.value, e.allowed)))?
         .params();
     if row.ideal {
         p = p.ideal();
@@ -70,7 +71,7 @@ pub fn row_params(row: &RowSpec, gravity: f64) -> SceneResult<RowParams> {
 /// x = (i − 1)(s + d); block 1 rotates clockwise about its front bottom edge
 /// at θ̇ = push/t̄. A [`Ground::NoSlip`] row's block–ground pair is
 /// `no_slip`.
-pub fn expand_row(scene: &mut Scene, row: &RowSpec) -> SceneResult<DominoRow> {
+pub fn expand_row(scene: &mut Scene, row: &RowSection) -> SceneResult<DominoRow> {
     let g = scene.gravity[0].hypot(scene.gravity[1]);
     let p = row_params(row, g)?;
     let domino = DominoRow::new(p, row.spacing * p.block.height, row.n, row.push);

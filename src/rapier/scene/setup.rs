@@ -5,7 +5,7 @@ use crate::coupling::{FallbackPolicy, ImpactReport, PairMaterial, PatchRule, Top
 use crate::impact::{ContactMaterial, ImpactSettings};
 use crate::rapier::{Precision, ToppleStats};
 
-use super::format::{PairLaw, RowOverrides, RowSpec as SceneRow, Scene, SolverSpec};
+use super::format::{PairLaw, RowOverrides, RowSection, Scene, SolverSpec};
 use crate::domino::{ChainReport, RowSpec as DominoRow};
 
 /// Who resolves impacts.
@@ -210,7 +210,7 @@ pub fn row_scene(row: &DominoRow, solver: SolverSpec, max_time: f64) -> Scene {
         pairs: Vec::new(),
         ground: None,
         bodies: Vec::new(),
-        row: Some(SceneRow {
+        row: Some(RowSection {
             preset: "T".into(), // every value is overridden below
             n: row.n,
             spacing: row.spacing_ratio(),

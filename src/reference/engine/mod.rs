@@ -43,9 +43,9 @@ mod window;
 /// Why a run failed.
 #[derive(Debug, thiserror::Error)]
 pub enum EngineError {
-    /// The row is not usable.
+    /// The row is not usable: the field, its value and the allowed range.
     #[error("invalid row: {0}")]
-    InvalidRow(String),
+    InvalidRow(crate::input::InputError),
     /// The impact resolver refused an impact's input (a non-finite state).
     #[error("impact at t = {time} s: {source}")]
     Impact {
