@@ -28,7 +28,7 @@ use std::time::Instant;
 use bevy::prelude::*;
 use bevy_rapier2d::prelude::*;
 use scenes::{Physics, Target};
-use topple::bevy::{headless_row_app, DominoRow, RowPhysics, ToppleFrameStats};
+use topple::bevy::{headless_row_app, DominoRow, ImpactResponse, ToppleFrameStats};
 use topple::domino::{Preset, RowSpec};
 
 #[path = "../examples/common/show.rs"]
@@ -152,7 +152,7 @@ fn pixel_scene(
     measure(&mut app, frames, ground_y)
 }
 
-fn row(physics: RowPhysics, n: usize, frames: usize) -> Run {
+fn row(physics: ImpactResponse, n: usize, frames: usize) -> Run {
     let p = Preset::T.params().ideal();
     let row = DominoRow {
         physics,
@@ -240,8 +240,8 @@ fn main() {
     }
     if want("row") {
         let f = 600;
-        let native = row(RowPhysics::Native, 1_000, f);
-        let topple = row(RowPhysics::Topple, 1_000, f);
+        let native = row(ImpactResponse::Native, 1_000, f);
+        let topple = row(ImpactResponse::Topple, 1_000, f);
         print("ideal Domino T row, 1,000 blocks, m", f, &native, &topple);
     }
     if want("show") {

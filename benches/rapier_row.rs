@@ -14,7 +14,7 @@
 
 use criterion::{criterion_group, criterion_main, BatchSize, Criterion};
 
-use topple::rapier::scene::{Engine, Scene};
+use topple::rapier::scene::{ImpactResponse, Scene};
 
 const DT: f64 = 1.0 / 60.0;
 
@@ -31,7 +31,7 @@ macro_rules! per_build {
         fn $name(c: &mut Criterion) {
             use topple::rapier::$build::build;
             let mut group = c.benchmark_group(concat!("rapier_row_", stringify!($build)));
-            for engine in [Engine::RapierNative, Engine::Rapier] {
+            for engine in [ImpactResponse::Native, ImpactResponse::Topple] {
                 // resting: a push too small to topple block 1, bodies kept awake
                 let mut sw = build(&row(1e-3), engine).unwrap();
                 for (_, h, _) in &sw.bodies {

@@ -24,7 +24,7 @@ use bevy::prelude::*;
 use bevy::window::WindowResolution;
 use bevy_rapier2d::plugin::RapierContextInitialization;
 use bevy_rapier2d::prelude::*;
-use topple::bevy::{rapier_plugin, DominoRow, DominoRowState, RowPhysics, TopplePlugin};
+use topple::bevy::{rapier_plugin, DominoRow, DominoRowState, ImpactResponse, TopplePlugin};
 use topple::domino::{Preset, RowSpec};
 use topple::theory::{solve, Geometry, Model};
 
@@ -189,7 +189,7 @@ fn spawn_rows(mut commands: Commands, mut demo: ResMut<Demo>) {
     let origin = demo.origin();
     let native = DominoRow {
         origin: origin + Vec2::new(0.0, ROW_GAP),
-        physics: RowPhysics::Native,
+        physics: ImpactResponse::Native,
         context: demo.native_context,
         ..DominoRow::new(demo.spec())
     };
@@ -231,8 +231,8 @@ fn decorate(mut commands: Commands, rows: Query<&DominoRowState, Added<DominoRow
 fn colour_blocks(rows: Query<&DominoRowState>, mut blocks: Query<(&Transform, &mut Sprite)>) {
     for row in &rows {
         let toppled = match row.physics {
-            RowPhysics::Topple => ORANGE,
-            RowPhysics::Native => BLUE,
+            ImpactResponse::Topple => ORANGE,
+            ImpactResponse::Native => BLUE,
         };
         for &e in &row.blocks {
             if let Ok((t, mut sprite)) = blocks.get_mut(e) {
@@ -261,8 +261,8 @@ fn hud(demo: Res<Demo>, rows: Query<&DominoRowState>, mut text: Query<&mut Text2
             lines.push(format!(
                 "{:>12}: blocks hit {:>3}/{}   v_na = {}",
                 match row.physics {
-                    RowPhysics::Native => "native (top)",
-                    RowPhysics::Topple => "topple",
+                    ImpactResponse::Native => "native (top)",
+                    ImpactResponse::Topple => "topple",
                 },
                 row.hit_times().len(),
                 row.spec.n,
@@ -369,8 +369,8 @@ fn rows_json(
             .collect();
         let upright = angles.iter().filter(|a| a.abs() < UPRIGHT).count();
         let origin = match row.physics {
-            RowPhysics::Native => demo.origin() + Vec2::new(0.0, ROW_GAP),
-            RowPhysics::Topple => demo.origin(),
+            ImpactResponse::Native => demo.origin() + Vec2::new(0.0, ROW_GAP),
+            ImpactResponse::Topple => demo.origin(),
         };
         let h = row.spec.params.block.height as f32;
         let (x0, y) = to_px(origin + Vec2::new(-h, 0.85 * h));
@@ -379,7 +379,7 @@ fn rows_json(
         let (_, top) = to_px(origin + Vec2::new(0.0, 1.2 * h));
         let (_, bottom) = to_px(origin + Vec2::new(0.0, -0.001));
         out.push(serde_json::json!({
-            "row": match row.physics { RowPhysics::Native => "native", RowPhysics::Topple => "topple" },
+            "row": match row.physics { ImpactResponse::Native => "native", ImpactResponse::Topple => "topple" },
             "n": row.spec.n,
             "upright": upright,
             "toppled": angles.len() - upright,
@@ -389,8 +389,8 @@ fn rows_json(
             "band_top": top.max(0.0).round(),
             "band_bottom": bottom.min(HEIGHT as f32 - 1.0).round(),
             "toppled_rgb": match row.physics {
-                RowPhysics::Native => [64, 140, 242],
-                RowPhysics::Topple => [242, 140, 38],
+                ImpactResponse::Native => [64, 140, 242],
+                ImpactResponse::Topple => [242, 140, 38],
             },
         }));
     }

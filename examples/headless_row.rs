@@ -14,7 +14,7 @@
 
 use std::process::ExitCode;
 
-use topple::bevy::{headless_row_app, DominoRow, DominoRowState, RowPhysics, ToppleFrameStats};
+use topple::bevy::{headless_row_app, DominoRow, DominoRowState, ImpactResponse, ToppleFrameStats};
 use topple::domino::{Preset, RowSpec};
 use topple::validate::{row as check_row, EngineKind, Naming, RunBudget};
 
@@ -83,9 +83,9 @@ fn run() -> Result<(), String> {
     check_row(&spec, &budget, Naming::Flags).map_err(|e| e.to_string())?;
     let row = DominoRow {
         physics: if a.native {
-            RowPhysics::Native
+            ImpactResponse::Native
         } else {
-            RowPhysics::Topple
+            ImpactResponse::Topple
         },
         ..DominoRow::new(spec)
     };

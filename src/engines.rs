@@ -14,12 +14,12 @@
 //! ```
 //! use topple::domino::{Preset, RowSpec};
 //! use topple::engines::{RapierRow, ReferenceRow, RowEngine};
-//! use topple::rapier::scene::Engine;
+//! use topple::rapier::scene::ImpactResponse;
 //! let p = Preset::T.params().ideal();
 //! let row = RowSpec::new(p, 0.5 * p.block.height, 4, 1.0);
 //! let engines: Vec<Box<dyn RowEngine>> = vec![
 //!     Box::new(ReferenceRow::default()),
-//!     Box::new(RapierRow::new(Engine::Rapier, 1.0 / 240.0)),
+//!     Box::new(RapierRow::new(ImpactResponse::Topple, 1.0 / 240.0)),
 //! ];
 //! for engine in &engines {
 //!     let report = engine.run(&row, &mut |_| {}).unwrap();
@@ -28,7 +28,7 @@
 //! ```
 
 use crate::domino::{ChainReport, RowSpec};
-use crate::rapier::scene::{Engine, SceneError, SolverSpec};
+use crate::rapier::scene::{ImpactResponse, SceneError, SolverSpec};
 use crate::rapier::Precision;
 use crate::reference::{EngineError, Settings};
 
@@ -74,7 +74,7 @@ impl RowEngine for ReferenceRow {
 #[derive(Clone, Debug)]
 pub struct RapierRow {
     /// Who resolves impacts.
-    pub engine: Engine,
+    pub engine: ImpactResponse,
     /// Which Rapier build.
     pub precision: Precision,
     /// Rapier's and topple's settings (its `dt` is Rapier's step, s).
@@ -87,7 +87,7 @@ impl RapierRow {
     /// `engine` on the f64 build (the f32 one when only it is compiled) at
     /// time step `dt` (s), default settings otherwise, stopping after 600 s
     /// of simulated time.
-    pub fn new(engine: Engine, dt: f64) -> Self {
+    pub fn new(engine: ImpactResponse, dt: f64) -> Self {
         RapierRow {
             engine,
             precision: Precision::default(),

@@ -14,7 +14,7 @@ use std::time::Duration;
 use bevy::prelude::*;
 use bevy::time::TimeUpdateStrategy;
 use bevy_rapier2d::prelude::*;
-use topple::bevy::{rapier_plugin, DefaultContext, ToppleConfig, ToppleMaterial, TopplePlugin};
+use topple::bevy::{rapier_plugin, ImpactResponse, ToppleConfig, ToppleMaterial, TopplePlugin};
 use topple::coupling::PairMaterial;
 use topple::impact::ContactMaterial;
 
@@ -158,8 +158,8 @@ pub fn material(e: &mut EntityCommands, target: Target, m: Mat) {
 /// by bevy_rapier, and topple's default settings.
 pub fn headless_app(physics: Physics) -> App {
     let who = match physics {
-        Physics::Topple => DefaultContext::Topple,
-        Physics::Native => DefaultContext::Native,
+        Physics::Topple => ImpactResponse::Topple,
+        Physics::Native => ImpactResponse::Native,
     };
     let mut app = App::new();
     app.add_plugins((MinimalPlugins, TransformPlugin))

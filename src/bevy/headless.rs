@@ -8,13 +8,13 @@ use bevy::time::TimeUpdateStrategy;
 use bevy_rapier2d::plugin::RapierContextInitialization;
 use bevy_rapier2d::prelude::*;
 
-use super::plugin::{rapier_plugin, DefaultContext, TopplePlugin};
-use super::row::{DominoRow, RowPhysics};
+use super::plugin::{rapier_plugin, TopplePlugin};
+use super::row::DominoRow;
 
 /// An app without window or renderer (MinimalPlugins, transforms,
 /// bevy_rapier and topple) stepping the row's context at a fixed `dt` (s),
 /// one physics step per `app.update()`, with the row spawned. A
-/// [`RowPhysics::Native`] row runs in a context stepped by bevy_rapier's own
+/// [`ImpactResponse::Native`](crate::rapier::ImpactResponse::Native) row runs in a context stepped by bevy_rapier's own
 /// code. Returns the app and the row entity (its [`super::DominoRowState`]).
 ///
 /// ```
@@ -36,10 +36,7 @@ pub fn headless_row_app(row: &DominoRow, dt: f64) -> Result<(App, Entity), Strin
         integration_parameters: row.integration_parameters(dt),
         rapier_configuration: row.rapier_configuration(),
     };
-    let who = match row.physics {
-        RowPhysics::Topple => DefaultContext::Topple,
-        RowPhysics::Native => DefaultContext::Native,
-    };
+    let who = row.physics;
     let mut app = App::new();
     app.add_plugins((MinimalPlugins, TransformPlugin))
         .add_plugins((

@@ -36,7 +36,7 @@
 //! | [`ToppleImpact`], [`ImpactPoint`] | message per resolved impact group |
 //! | [`ToppleNotice`] | message (and a warning) per collider whose impacts are left to Rapier |
 //! | [`ToppleWorld`], [`PhysicsClock`] | per context: topple's adapter, simulated time |
-//! | [`DominoRow`], [`DominoRowState`], [`RowPhysics`] | spawn a Table 1 row; its wave measures |
+//! | [`DominoRow`], [`DominoRowState`], [`ImpactResponse`] | spawn a Table 1 row; its wave measures |
 //! | [`SceneSpawn`], [`SpawnedScene`] | spawn a scene file of `topple scene` (scaled into the app's units) |
 //!
 //! ```no_run
@@ -65,9 +65,11 @@ mod scene;
 mod step;
 mod world;
 
+#[doc(no_inline)]
+pub use crate::rapier::ImpactResponse;
 pub use events::{ImpactPoint, ToppleImpact, ToppleNotice};
 pub use headless::{headless_row_app, step_frames};
-pub use plugin::{rapier_plugin, DefaultContext, TopplePlugin, ToppleSystems};
-pub use row::{DominoRow, DominoRowState, RowPhysics};
+pub use plugin::{rapier_plugin, TopplePlugin, ToppleSystems};
+pub use row::{DominoRow, DominoRowState};
 pub use scene::{SceneSpawn, SpawnedScene};
 pub use world::{PhysicsClock, ToppleConfig, ToppleFrameStats, ToppleMaterial, ToppleWorld};

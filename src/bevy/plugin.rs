@@ -10,6 +10,7 @@ use super::row::track_rows;
 use super::step::{attach_to_contexts, manage_colliders, step_contexts};
 use super::world::{ToppleConfig, ToppleFrameStats};
 use crate::coupling::ToppleSettings;
+use crate::rapier::ImpactResponse;
 
 /// The system sets topple adds to the physics schedule (see the table in
 /// [`crate::bevy`]).
@@ -61,18 +62,7 @@ pub fn rapier_plugin() -> RapierPhysicsPlugin<NoUserData> {
 pub struct TopplePlugin {
     schedule: InternedScheduleLabel,
     settings: ToppleSettings,
-    default_context: DefaultContext,
-}
-
-/// Who steps bevy_rapier's default context.
-#[derive(Resource, Debug, Clone, Copy, PartialEq, Eq, Default)]
-pub enum DefaultContext {
-    /// topple (a [`crate::bevy::ToppleWorld`] is put on it).
-    #[default]
-    Topple,
-    /// bevy_rapier's own step; topple steps only contexts that are given a
-    /// [`crate::bevy::ToppleWorld`] by the app.
-    Native,
+    default_context: ImpactResponse,
 }
 
 impl Default for TopplePlugin {
@@ -80,7 +70,7 @@ impl Default for TopplePlugin {
         TopplePlugin {
             schedule: PostUpdate.intern(),
             settings: ToppleSettings::default(),
-            default_context: DefaultContext::Topple,
+            default_context: ImpactResponse::Topple,
         }
     }
 }
@@ -93,7 +83,7 @@ impl TopplePlugin {
     }
 
     /// Who steps the default context (topple by default).
-    pub fn with_default_context(mut self, who: DefaultContext) -> Self {
+    pub fn with_default_context(mut self, who: ImpactResponse) -> Self {
         self.default_context = who;
         self
     }

@@ -14,26 +14,13 @@ use crate::rapier::f32::{integration_parameters, signed_gap, HitTracker};
 use crate::rapier::scene::{
     expand_row, pair_material, row_scene, topple_settings, PairLaw, SolverSpec,
 };
+use crate::rapier::ImpactResponse;
 
-/// Who resolves the row's impacts.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
-pub enum RowPhysics {
-    /// topple's LZB impacts ([`ToppleMaterial`] on every block and the ground).
-    #[default]
-    Topple,
-    /// Plain Rapier with the same friction and restitution per pair (Rapier's
-    /// combine rules Max for friction, Min for restitution give Table 1's
-    /// block–block and block–ground values, since μ2 ≥ μ1 and e2 ≤ e1).
-    Native,
-}
-
-impl RowPhysics {
-    /// The engine name `topple chain` reports for this kind of row.
-    pub fn engine_name(self) -> &'static str {
-        match self {
-            RowPhysics::Topple => "bevy-topple",
-            RowPhysics::Native => "bevy-native",
-        }
+/// The engine name `topple chain` reports for a Bevy row.
+fn engine_name(physics: ImpactResponse) -> &'static str {
+    match physics {
+        ImpactResponse::Topple => "bevy-topple",
+        ImpactResponse::Native => "bevy-native",
     }
 }
 
@@ -41,11 +28,11 @@ impl RowPhysics {
 /// centres (m), block 1 pushed, on a ground of the row's material.
 ///
 /// ```
-/// use topple::bevy::{DominoRow, RowPhysics};
+/// use topple::bevy::{DominoRow, ImpactResponse};
 /// use topple::domino::{Preset, RowSpec};
 /// let p = Preset::T.params().ideal();
 /// let row = DominoRow::new(RowSpec::new(p, 0.45 * p.block.height, 30, 1.0));
-/// assert_eq!(row.physics, RowPhysics::Topple);
+/// assert_eq!(row.physics, ImpactResponse::Topple);
 /// assert_eq!(row.spec.n, 30);
 /// ```
 #[derive(Clone, Debug, PartialEq)]
@@ -56,7 +43,7 @@ pub struct DominoRow {
     /// Where block 1's bottom centre stands (m).
     pub origin: Vec2,
     /// topple or plain Rapier.
-    pub physics: RowPhysics,
+    pub physics: ImpactResponse,
     /// The Rapier context of the row (`None`: the default context).
     pub context: Option<Entity>,
 }
@@ -67,7 +54,7 @@ impl DominoRow {
         DominoRow {
             spec,
             origin: Vec2::ZERO,
-            physics: RowPhysics::Topple,
+            physics: ImpactResponse::Topple,
             context: None,
         }
     }
@@ -131,7 +118,7 @@ impl DominoRow {
         self.spec.validate()?;
         let (block_law, ground_law) = self.laws();
         let (block, ground) = (pair_material(&block_law), pair_material(&ground_law));
-        if self.physics == RowPhysics::Topple {
+        if self.physics == ImpactResponse::Topple {
             commands.queue(move |world: &mut World| {
                 let mut config = world.get_resource_or_insert_with(ToppleConfig::default);
                 config.set_pair(block, block, block);
@@ -194,10 +181,10 @@ impl DominoRow {
     /// row, and the context link.
     fn add_material(&self, e: &mut EntityCommands, m: PairMaterial, law: &PairLaw) {
         match self.physics {
-            RowPhysics::Topple => {
+            ImpactResponse::Topple => {
                 e.insert(ToppleMaterial(m));
             }
-            RowPhysics::Native => {
+            ImpactResponse::Native => {
                 e.insert((
                     Friction {
                         coefficient: law.friction as f32,
@@ -223,7 +210,7 @@ pub struct DominoRowState {
     /// The row as spawned.
     pub spec: RowSpec,
     /// topple or plain Rapier.
-    pub physics: RowPhysics,
+    pub physics: ImpactResponse,
     /// Its Rapier context (`None`: the default one).
     pub context: Option<Entity>,
     /// The blocks, in row order.
@@ -250,7 +237,7 @@ impl DominoRowState {
     /// v̂_na over the steady blocks: [`crate::domino::WaveMeasures`]).
     pub fn report(&self) -> ChainReport {
         ChainReport::new(
-            self.physics.engine_name(),
+            engine_name(self.physics),
             &self.spec,
             self.hits.hit_times.clone(),
         )

@@ -8,7 +8,7 @@ use bevy::prelude::*;
 use bevy_rapier2d::prelude::*;
 use bevy_rapier2d::rapier::prelude::IntegrationParameters;
 
-use super::row::{DominoRowState, RowPhysics};
+use super::row::DominoRowState;
 use super::world::{ToppleConfig, ToppleMaterial};
 use crate::coupling::{PairMaterial, ToppleSettings};
 use crate::rapier::f32::{integration_parameters, HitTracker};
@@ -16,6 +16,7 @@ use crate::rapier::scene::{
     expand_row, pair_material, topple_settings, BodySpec, PairLaw, Scene, SceneError, SceneResult,
     ShapeKind,
 };
+use crate::rapier::ImpactResponse;
 
 /// How to spawn a scene file into a Bevy app: where, at what scale, with
 /// which physics, in which Rapier context.
@@ -69,7 +70,7 @@ pub struct SceneSpawn<'a> {
     /// Where the scene's origin goes (world units).
     pub origin: Vec2,
     /// topple or native bevy_rapier.
-    pub physics: RowPhysics,
+    pub physics: ImpactResponse,
     /// The Rapier context (`None`: the default one).
     pub context: Option<Entity>,
 }
@@ -94,7 +95,7 @@ impl<'a> SceneSpawn<'a> {
             scene,
             scale: 1.0,
             origin: Vec2::ZERO,
-            physics: RowPhysics::Topple,
+            physics: ImpactResponse::Topple,
             context: None,
         }
     }
@@ -106,7 +107,7 @@ impl<'a> SceneSpawn<'a> {
     }
 
     /// With native bevy_rapier (or topple).
-    pub fn with_physics(mut self, physics: RowPhysics) -> Self {
+    pub fn with_physics(mut self, physics: ImpactResponse) -> Self {
         self.physics = physics;
         self
     }
@@ -181,7 +182,7 @@ impl<'a> SceneSpawn<'a> {
         }
         // everything is checked: spawn
         let table_rules = !scene.pairs.is_empty();
-        if self.physics == RowPhysics::Topple && table_rules {
+        if self.physics == ImpactResponse::Topple && table_rules {
             commands.queue(move |world: &mut World| {
                 let mut config = world.get_resource_or_insert_with(ToppleConfig::default);
                 for (a, b, rule) in rules {
@@ -269,10 +270,10 @@ impl<'a> SceneSpawn<'a> {
     /// context link.
     fn add_material(&self, e: &mut EntityCommands, m: PairMaterial, law: &PairLaw, table: bool) {
         match self.physics {
-            RowPhysics::Topple => {
+            ImpactResponse::Topple => {
                 e.insert(ToppleMaterial(m));
             }
-            RowPhysics::Native => {
+            ImpactResponse::Native => {
                 let (friction, restitution) = if table {
                     (CoefficientCombineRule::Max, CoefficientCombineRule::Min)
                 } else {

@@ -12,9 +12,9 @@ use bevy_rapier2d::prelude::*;
 use bevy_rapier2d::rapier::math::Real;
 
 use super::events::{collect, CollisionCollector, ToppleImpact, ToppleNotice};
-use super::plugin::DefaultContext;
 use super::world::{PhysicsClock, ToppleConfig, ToppleFrameStats, ToppleMaterial, ToppleWorld};
 use crate::rapier::f32::StepParts;
+use crate::rapier::ImpactResponse;
 use crate::rapier::ToppleStats;
 
 /// The Rapier steps of one frame for a timestep mode, as bevy_rapier takes
@@ -282,7 +282,7 @@ fn warn_left(
 pub(crate) fn attach_to_contexts(
     mut commands: Commands,
     config: Res<ToppleConfig>,
-    who: Res<DefaultContext>,
+    who: Res<ImpactResponse>,
     clockless: Query<Entity, (With<RapierContextSimulation>, Without<PhysicsClock>)>,
     default: Query<Entity, (With<DefaultRapierContext>, Without<ToppleWorld>)>,
     attached: Local<bool>,
@@ -291,7 +291,7 @@ pub(crate) fn attach_to_contexts(
     for e in &clockless {
         commands.entity(e).insert(PhysicsClock::default());
     }
-    if !*attached && *who == DefaultContext::Topple {
+    if !*attached && *who == ImpactResponse::Topple {
         for e in &default {
             commands.entity(e).insert(ToppleWorld::new(config.settings));
             *attached = true;

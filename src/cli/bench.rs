@@ -41,7 +41,7 @@ use super::chain::{row_spec, RowArgs};
 use topple::domino::{ChainReport, RowSpec};
 use topple::engines::{RapierRow, ReferenceRow, RowEngine};
 use topple::impact::StepControl;
-use topple::rapier::scene::{Engine, SolverSpec, WorkBudget};
+use topple::rapier::scene::{ImpactResponse, SolverSpec, WorkBudget};
 use topple::rapier::Precision;
 use topple::reference::{Integrator, Settings};
 
@@ -269,14 +269,14 @@ fn execute_with(
             tolerance,
             precision,
         } => Box::new(rapier(
-            Engine::Rapier,
+            ImpactResponse::Topple,
             dt,
             impulse_step,
             tolerance,
             precision,
         )),
         RunKind::Native { dt, precision } => {
-            Box::new(rapier(Engine::RapierNative, dt, None, None, precision))
+            Box::new(rapier(ImpactResponse::Native, dt, None, None, precision))
         }
     };
     Ok(engine.run(row, &mut progress)?)

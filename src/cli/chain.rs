@@ -8,7 +8,7 @@ use anyhow::Context;
 use topple::domino::{Ground, Preset, RowParams, RowSpec};
 use topple::engines::{RapierRow, RowEngine};
 use topple::impact::StepControl;
-use topple::rapier::scene::{Engine, SolverSpec, WorkBudget};
+use topple::rapier::scene::{ImpactResponse, SolverSpec, WorkBudget};
 use topple::reference::{snapshot_png, snapshot_svg, Integrator, Settings};
 use topple::theory::{Geometry, Model, Outcome};
 use topple::validate::{self, EngineKind, InputError, Naming, RunBudget};
@@ -340,8 +340,8 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     let row = check_args(&args)?;
     match args.engine {
         EngineArg::Reference => run_reference(&args, &row),
-        EngineArg::Rapier => run_rapier(&args, &row, Engine::Rapier),
-        EngineArg::RapierNative => run_rapier(&args, &row, Engine::RapierNative),
+        EngineArg::Rapier => run_rapier(&args, &row, ImpactResponse::Topple),
+        EngineArg::RapierNative => run_rapier(&args, &row, ImpactResponse::Native),
     }
 }
 
@@ -371,7 +371,7 @@ fn reference_settings(args: &Args) -> Settings {
 }
 
 /// A row through Rapier, with topple or natively.
-fn run_rapier(args: &Args, row: &RowSpec, engine: Engine) -> anyhow::Result<()> {
+fn run_rapier(args: &Args, row: &RowSpec, engine: ImpactResponse) -> anyhow::Result<()> {
     let rapier = RapierRow {
         engine,
         precision: args.precision,

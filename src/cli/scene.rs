@@ -3,7 +3,7 @@
 use std::path::PathBuf;
 
 use anyhow::Context;
-use topple::rapier::scene::{run_scene, Engine, RunOptions, Scene};
+use topple::rapier::scene::{run_scene, ImpactResponse, RunOptions, Scene};
 use topple::rapier::Precision;
 
 /// Arguments of `topple scene`.
@@ -12,8 +12,8 @@ pub struct Args {
     /// TOML scene file (see assets/scenes/).
     pub file: PathBuf,
     /// Who resolves impacts.
-    #[arg(long, value_enum, default_value_t = Engine::Rapier)]
-    pub engine: Engine,
+    #[arg(long, value_enum, default_value_t = ImpactResponse::Topple)]
+    pub engine: ImpactResponse,
     /// Print JSON instead of text.
     #[arg(long)]
     pub json: bool,

@@ -7,7 +7,7 @@
 //! | --- | --- | --- |
 //! | [`f64::ToppleRapier`], [`f32::ToppleRapier`] | the adapter: Rapier step, impact pass, velocities back | per build |
 //! | [`f64::ToppleHooks`], [`f32::ToppleHooks`] | physics hook: per-pair friction, Rapier's restitution off on managed pairs | per build |
-//! | [`HookMode`], [`ToppleStats`], [`Precision`], [`LeftToRapier`] | who resolves impacts, running totals, which build, why a collider's impacts are Rapier's | agnostic |
+//! | [`ImpactResponse`], [`ToppleStats`], [`Precision`], [`LeftToRapier`] | who resolves impacts, running totals, which build, why a collider's impacts are Rapier's | agnostic |
 //! | [`scene`] | TOML scenes (boxes, balls, domino rows) run with or without topple, in either precision | agnostic front, per-build worlds |
 //!
 //! Materials, λ-point patches, impact groups and the fallback policy live in
@@ -83,24 +83,49 @@ use crate::coupling::{ImpactReport, Resolution};
 /// and 1.46). Both engines of a row comparison use the same value.
 pub const ROW_CONTACT_HERTZ: f64 = 480.0;
 
-/// Who resolves impacts on managed pairs.
+/// Who resolves the impacts: topple (the LZB model with λ-point contact) or
+/// Rapier itself (its own restitution per pair). One choice for every layer:
+/// a Rapier world's hooks, a scene run, a domino row, the Bevy plugin's
+/// default context and its rows, the CLI and the stress sweep. On the command
+/// line and in JSON reports its values are `rapier` (topple on Rapier) and
+/// `rapier-native`.
 ///
 /// ```
 /// use topple::coupling::ToppleSettings;
-/// use topple::rapier::{f64::ToppleRapier, HookMode};
-/// assert_eq!(ToppleRapier::new(ToppleSettings::default()).hooks().mode(), HookMode::Topple);
-/// assert_eq!(ToppleRapier::native().hooks().mode(), HookMode::Native);
+/// use topple::rapier::{f64::ToppleRapier, ImpactResponse};
+/// assert_eq!(ToppleRapier::new(ToppleSettings::default()).hooks().mode(), ImpactResponse::Topple);
+/// assert_eq!(ToppleRapier::native().hooks().mode(), ImpactResponse::Native);
+/// assert_eq!(ImpactResponse::Native.name(), "rapier-native");
+/// assert_eq!(ImpactResponse::default(), ImpactResponse::Topple);
 /// ```
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum HookMode {
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default, serde::Serialize)]
+#[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
+#[cfg_attr(feature = "bevy", derive(bevy::prelude::Resource))]
+pub enum ImpactResponse {
     /// topple resolves impacts; Rapier keeps resting contact with restitution 0
     /// and without the contact points that are still open (speculative) or
     /// approach faster than topple's impact threshold: Rapier would stop those
     /// inelastically at the moment of touching, before topple sees them.
+    #[default]
+    #[serde(rename = "rapier")]
+    #[cfg_attr(feature = "cli", value(name = "rapier"))]
     Topple,
     /// Rapier resolves impacts itself with the pair's restitution; the hook
     /// only sets friction and restitution per pair (native Rapier response).
+    #[serde(rename = "rapier-native")]
+    #[cfg_attr(feature = "cli", value(name = "rapier-native"))]
     Native,
+}
+
+impl ImpactResponse {
+    /// The name used on the command line and in JSON: `rapier` or
+    /// `rapier-native`.
+    pub fn name(self) -> &'static str {
+        match self {
+            ImpactResponse::Topple => "rapier",
+            ImpactResponse::Native => "rapier-native",
+        }
+    }
 }
 
 /// Which Rapier build runs a world. Each is compiled only with its cargo

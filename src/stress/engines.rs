@@ -6,7 +6,7 @@ use super::combo::{Combo, SplitMix64, StressEngine};
 use super::observe::{Observation, RowWatch};
 use crate::coupling::{FallbackPolicy, GroupSolver};
 use crate::impact::{audit, Body, Contact, ContactMaterial, ImpactOutcome, ImpactSettings};
-use crate::rapier::scene::{row_scene, Engine, SolverSpec};
+use crate::rapier::scene::{row_scene, ImpactResponse, SolverSpec};
 use crate::reference::{Integrator, Settings};
 
 /// Simulated time (s) a row gets: 4 t̄ per block and 2 s, far beyond the
@@ -21,9 +21,9 @@ pub fn run_combo(c: &Combo, budget: f64) -> Observation {
     let start = Instant::now();
     let mut seen = match c.engine {
         StressEngine::Reference => reference(c, budget),
-        StressEngine::RapierF64 => rapier_f64(c, Engine::Rapier, budget),
-        StressEngine::RapierF32 => rapier_f32(c, Engine::Rapier, budget),
-        StressEngine::Native => rapier_f64(c, Engine::RapierNative, budget),
+        StressEngine::RapierF64 => rapier_f64(c, ImpactResponse::Topple, budget),
+        StressEngine::RapierF32 => rapier_f32(c, ImpactResponse::Topple, budget),
+        StressEngine::Native => rapier_f64(c, ImpactResponse::Native, budget),
         StressEngine::Impact => free_impact(c),
     };
     seen.wall = start.elapsed().as_secs_f64();
@@ -93,7 +93,7 @@ macro_rules! rapier_runner {
     ($name:ident, $adapter:ident, $backend:ident) => {
         /// A Rapier build of the row, its blocks perturbed, observed after
         /// every step.
-        fn $name(c: &Combo, engine: Engine, budget: f64) -> Observation {
+        fn $name(c: &Combo, engine: ImpactResponse, budget: f64) -> Observation {
             use crate::rapier::$adapter as adapter;
             use crate::$backend::math::{Pose, Real, Vector};
             let t_end = sim_time(c);

@@ -4,7 +4,7 @@
 //! frame, twice side by side for the bits, and the memory sampled at the end
 //! of every cycle.
 
-use crate::rapier::scene::{Engine, Scene};
+use crate::rapier::scene::{ImpactResponse, Scene};
 use crate::rapier::Precision;
 
 use super::scene::run::{run_with, Hooks};
@@ -104,7 +104,7 @@ pub fn soak(scene: &Scene, spec: &SoakSpec, memory: impl Fn() -> Option<u64> + S
             frames: spec.frames,
             reset: Some(&mut reset),
         };
-        let seen = run_with(scene, Engine::Rapier, spec.precision, &mut hooks);
+        let seen = run_with(scene, ImpactResponse::Topple, spec.precision, &mut hooks);
         (seen, samples, cycles)
     };
     let ((seen, memory, cycles), (again, _, _)) = crate::par::join(|| one(true), || one(false));

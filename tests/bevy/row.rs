@@ -3,10 +3,9 @@
 //! reduced model), and native bevy_rapier; plus run-to-run determinism.
 
 use bevy::prelude::*;
-use topple::bevy::{headless_row_app, step_frames, DominoRow, DominoRowState, RowPhysics};
+use topple::bevy::{headless_row_app, step_frames, DominoRow, DominoRowState, ImpactResponse};
 use topple::domino::{Preset, RowSpec};
 use topple::engines::{RapierRow, ReferenceRow, RowEngine};
-use topple::rapier::scene::Engine;
 
 const DT: f64 = 1.0 / 60.0;
 
@@ -41,7 +40,7 @@ fn topple_row_matches_the_f64_plugin_and_the_reference() {
     let bevy = bevy_row(&DominoRow::new(spec));
     assert!(bevy.finished(), "the wave stopped: {:?}", bevy.hit_times());
     let v_bevy = speed(&bevy);
-    let plugin = RapierRow::new(Engine::Rapier, DT)
+    let plugin = RapierRow::new(ImpactResponse::Topple, DT)
         .run(&spec, &mut |_| {})
         .unwrap();
     let v_plugin = plugin.natural_speed.unwrap();
@@ -62,7 +61,7 @@ fn topple_row_matches_the_f64_plugin_and_the_reference() {
 fn native_row_is_slow_the_way_native_rapier_is() {
     let spec = spec(40);
     let native = bevy_row(&DominoRow {
-        physics: RowPhysics::Native,
+        physics: ImpactResponse::Native,
         ..DominoRow::new(spec)
     });
     let topple = bevy_row(&DominoRow::new(spec));

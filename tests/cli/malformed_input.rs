@@ -352,7 +352,7 @@ fn scene_toml() -> impl Strategy<Value = String> {
 /// Loads, checks and (when valid) runs a scene for at most 20 steps: a
 /// result or an error, never a panic.
 fn scene_case(text: &str) -> Result<(), TestCaseError> {
-    use topple::rapier::scene::{run_scene, Engine, RunOptions, Scene};
+    use topple::rapier::scene::{run_scene, ImpactResponse, RunOptions, Scene};
     let scene: Scene = match topple::validate::parse_toml(text, "s.toml") {
         Ok(s) => s,
         Err(e) => {
@@ -375,7 +375,7 @@ fn scene_case(text: &str) -> Result<(), TestCaseError> {
     SEEN[5].fetch_add(1, Relaxed);
     let mut short = scene.clone();
     short.duration = short.duration.min(20.0 * short.solver.dt);
-    for engine in [Engine::Rapier, Engine::RapierNative] {
+    for engine in [ImpactResponse::Topple, ImpactResponse::Native] {
         // an error is allowed (e.g. an unknown material); a panic is not
         if let Ok(out) = run_scene(
             &short,

@@ -6,7 +6,7 @@
 
 use topple::coupling::{Resolution, ToppleSettings};
 use topple::rapier::f64::build;
-use topple::rapier::scene::{load_scene, Engine, Scene, WorkBudget};
+use topple::rapier::scene::{load_scene, ImpactResponse, Scene, WorkBudget};
 
 fn pile() -> Scene {
     let path =
@@ -19,7 +19,7 @@ fn pile() -> Scene {
 /// Also checks every impact report against energy creation and every body
 /// against NaN and the ground.
 fn step_work(scene: &Scene, seconds: f64) -> (Vec<(u64, u64)>, u64) {
-    let mut sw = build(scene, Engine::Rapier).unwrap();
+    let mut sw = build(scene, ImpactResponse::Topple).unwrap();
     let steps = (seconds / sw.world.integration_parameters.dt).round() as usize;
     let mut out = Vec::with_capacity(steps);
     for _ in 0..steps {

@@ -14,7 +14,7 @@ use std::alloc::{GlobalAlloc, Layout, System};
 use std::cell::Cell;
 
 use topple::rapier::f64::{build, SceneWorld};
-use topple::rapier::scene::{load_scene, Engine};
+use topple::rapier::scene::{load_scene, ImpactResponse};
 
 struct Counting;
 
@@ -124,7 +124,7 @@ fn a_domino_wave_allocates_nothing_once_its_buffers_have_grown() {
     let mut s = scene("domino-row-x.toml");
     s.row.as_mut().unwrap().n = 30;
     s.solver.max_group_hops = Some(8);
-    let mut warm = build(&s, Engine::Rapier).unwrap();
+    let mut warm = build(&s, ImpactResponse::Topple).unwrap();
     let steps = (1.2 / warm.world.integration_parameters.dt) as usize;
     let mut first = (0, 0);
     for _ in 0..steps {
@@ -132,7 +132,7 @@ fn a_domino_wave_allocates_nothing_once_its_buffers_have_grown() {
         first.0 += n;
         first.1 += a;
     }
-    let mut sw = build(&s, Engine::Rapier).unwrap();
+    let mut sw = build(&s, ImpactResponse::Topple).unwrap();
     // same construction, so the same collider handles and materials
     sw.topple = warm.topple;
     let (mut impacts, mut allocations, mut rapier_share) = (0, 0, 0);
@@ -172,7 +172,7 @@ fn sleeping_bodies_are_not_queried() {
     // A box dropped flat comes to rest and falls asleep; from then on topple
     // queries no pair.
     let s = scene("box-drop-flat.toml");
-    let mut sw = build(&s, Engine::Rapier).unwrap();
+    let mut sw = build(&s, ImpactResponse::Topple).unwrap();
     let dt = sw.world.integration_parameters.dt;
     let mut asleep_at = None;
     for k in 0..(10.0 / dt) as usize {

@@ -2,7 +2,7 @@
 //! independently of the program (RK4 on m ẍ = forces of F = k δ^1.5).
 //! Native Rapier's distance from the same chain is printed for the record.
 
-use topple::rapier::scene::{run_scene, Engine, RunOptions, Scene};
+use topple::rapier::scene::{run_scene, ImpactResponse, RunOptions, Scene};
 use topple::rapier::Precision;
 
 const K: f64 = 2.3e10; // N/m^1.5
@@ -75,7 +75,7 @@ fn hertz_chain(n: usize) -> Vec<f64> {
     v
 }
 
-fn final_vx(scene: &Scene, engine: Engine) -> Vec<f64> {
+fn final_vx(scene: &Scene, engine: ImpactResponse) -> Vec<f64> {
     let out = run_scene(scene, engine, Precision::F64, RunOptions::default()).unwrap();
     out.bodies.iter().map(|b| b.velocity[0]).collect()
 }
@@ -87,8 +87,8 @@ fn check(n: usize) {
     let e: f64 = chain.iter().map(|v| 0.5 * M * v * v).sum();
     assert!((p - M * V0).abs() < 1e-9 && (e - 0.5 * M * V0 * V0).abs() < 1e-6);
     let s = scene(n);
-    let topple = final_vx(&s, Engine::Rapier);
-    let native = final_vx(&s, Engine::RapierNative);
+    let topple = final_vx(&s, ImpactResponse::Topple);
+    let native = final_vx(&s, ImpactResponse::Native);
     let err = |v: &[f64]| {
         v.iter()
             .zip(&chain)

@@ -1,6 +1,6 @@
 //! The same scene run twice gives the same bits.
 
-use topple::rapier::scene::{load_scene, run_scene, Engine, RunOptions};
+use topple::rapier::scene::{load_scene, run_scene, ImpactResponse, RunOptions};
 use topple::rapier::Precision;
 
 #[test]
@@ -10,7 +10,7 @@ fn same_scene_twice_gives_identical_results() {
     let mut scene = load_scene(&path).unwrap();
     scene.row.as_mut().unwrap().n = 12;
     scene.duration = 0.6;
-    for engine in [Engine::Rapier, Engine::RapierNative] {
+    for engine in [ImpactResponse::Topple, ImpactResponse::Native] {
         let a = serde_json::to_string(
             &run_scene(&scene, engine, Precision::F64, RunOptions::default()).unwrap(),
         )

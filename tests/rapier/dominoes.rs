@@ -11,7 +11,7 @@
 //! blocks to forget the push, so that row is longer. Native Rapier's value is
 //! printed for the record.
 
-use topple::rapier::scene::{run_scene, Engine, RunOptions, Scene};
+use topple::rapier::scene::{run_scene, ImpactResponse, RunOptions, Scene};
 use topple::rapier::Precision;
 use topple::theory::{solve, Geometry, Model};
 
@@ -26,7 +26,7 @@ fn ideal_row(spacing: f64, n: usize) -> Scene {
     .unwrap()
 }
 
-fn natural_speed(scene: &Scene, engine: Engine) -> f64 {
+fn natural_speed(scene: &Scene, engine: ImpactResponse) -> f64 {
     let options = RunOptions {
         stop_after_last_hit: true,
         ..RunOptions::default()
@@ -48,8 +48,8 @@ fn check(spacing: f64, n: usize) {
         .natural_speed()
         .unwrap();
     let scene = ideal_row(spacing, n);
-    let topple = natural_speed(&scene, Engine::Rapier);
-    let native = natural_speed(&scene, Engine::RapierNative);
+    let topple = natural_speed(&scene, ImpactResponse::Topple);
+    let native = natural_speed(&scene, ImpactResponse::Native);
     let rel = |v: f64| (v - cooperative) / cooperative;
     eprintln!(
         "s/h {spacing}: cooperative {cooperative:.4}, topple {topple:.4} ({:+.2}%), native {native:.4} ({:+.2}%)",

@@ -8,7 +8,7 @@
 
 use topple::impact::{resolve, Body, Contact, ContactMaterial, ImpactSettings};
 use topple::rapier::f64::build;
-use topple::rapier::scene::{Engine, Scene};
+use topple::rapier::scene::{ImpactResponse, Scene};
 
 const W: f64 = 0.10; // m
 const H: f64 = 0.05; // m
@@ -42,7 +42,7 @@ fn inertia() -> f64 {
 /// Runs until the first impact and returns (velocity, ω) just after it, the
 /// highest centre height after it, and the largest relative energy gain of any
 /// impact.
-fn run(scene: &Scene, engine: Engine) -> ([f64; 2], f64, f64, f64) {
+fn run(scene: &Scene, engine: ImpactResponse) -> ([f64; 2], f64, f64, f64) {
     let mut sw = build(scene, engine).unwrap();
     let h = sw.bodies[0].1;
     let mut after: Option<([f64; 2], f64)> = None;
@@ -91,8 +91,8 @@ fn box_dropped_flat_rebounds_as_the_resolver_says() {
     let v_out = out.bodies[0].velocity[1];
     let apex_expected = 0.5 * H + v_out * v_out / (2.0 * G);
 
-    let (v, w, apex, gain) = run(&scene(y0, 0.0), Engine::Rapier);
-    let (_, _, apex_native, _) = run(&scene(y0, 0.0), Engine::RapierNative);
+    let (v, w, apex, gain) = run(&scene(y0, 0.0), ImpactResponse::Topple);
+    let (_, _, apex_native, _) = run(&scene(y0, 0.0), ImpactResponse::Native);
     eprintln!(
         "flat drop: resolver v' = {v_out:.5} m/s, apex {apex_expected:.5} m; \
          topple v' = {:.5}, w' = {w:.2e}, apex {apex:.5} m; native apex {apex_native:.5} m",
@@ -124,8 +124,8 @@ fn box_dropped_on_edge_spins_as_the_resolver_says() {
     let out = resolve(&[body], &[contact], &ImpactSettings::default()).unwrap();
     let expect = out.bodies[0];
 
-    let (v, w, _, gain) = run(&scene(y0, theta), Engine::Rapier);
-    let (vn, wn, _, _) = run(&scene(y0, theta), Engine::RapierNative);
+    let (v, w, _, gain) = run(&scene(y0, theta), ImpactResponse::Topple);
+    let (vn, wn, _, _) = run(&scene(y0, theta), ImpactResponse::Native);
     eprintln!(
         "edge drop: resolver v' = {:.5?}, w' = {:.4}; topple v' = {v:.5?}, w' = {w:.4}; \
          native v' = {vn:.5?}, w' = {wn:.4}",

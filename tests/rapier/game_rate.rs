@@ -9,12 +9,12 @@
 //!   momentum and kinetic energy to 10⁻⁶ in one 1/60 s step, where native
 //!   Rapier loses a large part of the energy.
 
-use topple::rapier::scene::{run_scene, Engine, RunOptions, Scene, SceneOutput};
+use topple::rapier::scene::{run_scene, ImpactResponse, RunOptions, Scene, SceneOutput};
 use topple::rapier::Precision;
 
 const DT: f64 = 1.0 / 60.0;
 
-fn run(scene: &Scene, engine: Engine, precision: Precision) -> SceneOutput {
+fn run(scene: &Scene, engine: ImpactResponse, precision: Precision) -> SceneOutput {
     run_scene(scene, engine, precision, RunOptions::default()).unwrap()
 }
 
@@ -44,7 +44,11 @@ fn closed_form(v: f64, t_hit: f64, e: f64, t: f64) -> [(f64, f64); 2] {
 
 fn check_against_closed_form(t_hit: f64, precision: Precision, tol: f64) {
     let (v, e, steps) = (1.0, 0.5, 3);
-    let out = run(&two_balls(v, t_hit, e, steps), Engine::Rapier, precision);
+    let out = run(
+        &two_balls(v, t_hit, e, steps),
+        ImpactResponse::Topple,
+        precision,
+    );
     assert_eq!(out.impacts.len(), 1, "{:?}", out.impacts);
     let expected = closed_form(v, t_hit, e, out.time);
     for (b, (x, vx)) in out.bodies.iter().zip(expected) {
@@ -97,13 +101,13 @@ fn a_cradle_of_boxes_keeps_momentum_and_energy_in_one_game_step() {
     let scene = box_cradle();
     let (p0, e0) = (1.0, 0.5);
     for precision in [Precision::F64, Precision::F32] {
-        let out = run(&scene, Engine::Rapier, precision);
+        let out = run(&scene, ImpactResponse::Topple, precision);
         let (p, e) = momentum_and_energy(&out);
         eprintln!("topple {precision:?}: momentum {p}, kinetic energy {e}");
         assert!(((p - p0) / p0).abs() < 1e-6, "momentum {p}");
         assert!(((e - e0) / e0).abs() < 1e-6, "kinetic energy {e}");
     }
-    let native = run(&scene, Engine::RapierNative, Precision::F64);
+    let native = run(&scene, ImpactResponse::Native, Precision::F64);
     let (_, e) = momentum_and_energy(&native);
     eprintln!("native: kinetic energy {e}");
     assert!(e < 0.8 * e0, "native Rapier kept {e} J of {e0} J");
@@ -143,9 +147,9 @@ fn the_ideal_row_at_60_hz_is_close_to_the_reference_and_far_closer_than_native()
             .natural_speed
             .unwrap()
     };
-    let f64_ = speed(Engine::Rapier, Precision::F64);
-    let f32_ = speed(Engine::Rapier, Precision::F32);
-    let native = speed(Engine::RapierNative, Precision::F64);
+    let f64_ = speed(ImpactResponse::Topple, Precision::F64);
+    let f32_ = speed(ImpactResponse::Topple, Precision::F32);
+    let native = speed(ImpactResponse::Native, Precision::F64);
     let err = |v: f64| (v - reference) / reference;
     eprintln!(
         "reference {reference:.4}; topple f64 {f64_:.4} ({:+.2} %), f32 {f32_:.4} ({:+.2} %); native {native:.4} ({:+.2} %)",

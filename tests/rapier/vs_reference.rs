@@ -5,7 +5,7 @@
 
 use topple::domino::{Preset, RowSpec};
 use topple::rapier::scene::run_row;
-use topple::rapier::scene::{Engine, SolverSpec, WorkBudget};
+use topple::rapier::scene::{ImpactResponse, SolverSpec, WorkBudget};
 use topple::rapier::Precision;
 use topple::reference::{Integrator, Settings};
 
@@ -40,7 +40,7 @@ fn compare(spacing_ratio: f64, n: usize) {
     };
     let topple = run_row(
         &row,
-        Engine::Rapier,
+        ImpactResponse::Topple,
         Precision::F64,
         solver.clone(),
         20.0,
@@ -49,7 +49,7 @@ fn compare(spacing_ratio: f64, n: usize) {
     .unwrap();
     let native = run_row(
         &row,
-        Engine::RapierNative,
+        ImpactResponse::Native,
         Precision::F64,
         solver,
         20.0,

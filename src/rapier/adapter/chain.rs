@@ -4,7 +4,7 @@
 use std::time::Instant;
 
 use crate::domino::{ChainReport, RowSpec};
-use crate::rapier::scene::{row_scene, Engine, SceneResult, SolverSpec};
+use crate::rapier::scene::{row_scene, ImpactResponse, SceneResult, SolverSpec};
 
 use super::{build, HitTracker};
 
@@ -15,7 +15,7 @@ use super::{build, HitTracker};
 /// another block. See [`crate::rapier::scene::run_row`] for either build.
 pub fn run_row(
     row: &RowSpec,
-    engine: Engine,
+    engine: ImpactResponse,
     solver: SolverSpec,
     max_time: f64,
     mut progress: impl FnMut(usize),

@@ -23,7 +23,7 @@ use super::backend::prelude::{
 
 use super::support::{self, Notice};
 use crate::coupling::{MaterialId, MaterialTable, PairMaterial};
-use crate::rapier::HookMode;
+use crate::rapier::ImpactResponse;
 
 /// Materials of the managed colliders, read by the hook during Rapier's step.
 /// [`super::ToppleRapier::step`] hands it to Rapier; a caller that runs
@@ -46,7 +46,7 @@ use crate::rapier::HookMode;
 pub struct ToppleHooks {
     pub(crate) table: MaterialTable,
     collider_material: Vec<u16>,
-    pub(crate) mode: HookMode,
+    pub(crate) mode: ImpactResponse,
     /// Points approaching faster than this (world units per second) are
     /// topple's: the step's impact threshold
     /// ([`super::scale::effective`]).
@@ -75,7 +75,7 @@ pub(crate) fn pair_key(a: ColliderHandle, b: ColliderHandle) -> u64 {
 }
 
 impl ToppleHooks {
-    pub(crate) fn new(mode: HookMode) -> Self {
+    pub(crate) fn new(mode: ImpactResponse) -> Self {
         ToppleHooks {
             table: MaterialTable::default(),
             collider_material: Vec::new(),
@@ -116,7 +116,7 @@ impl ToppleHooks {
     }
 
     /// Who resolves impacts.
-    pub fn mode(&self) -> HookMode {
+    pub fn mode(&self) -> ImpactResponse {
         self.mode
     }
 
@@ -146,7 +146,7 @@ impl ToppleHooks {
             return false;
         };
         *context.friction = pair.smooth_friction as Real;
-        if self.mode == HookMode::Native {
+        if self.mode == ImpactResponse::Native {
             *context.restitution = pair.impact.restitution as Real;
             return true;
         }

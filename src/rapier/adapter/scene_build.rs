@@ -11,8 +11,8 @@ use super::backend::prelude::{
 use super::ToppleRapier;
 use crate::coupling::{ImpactReport, MaterialId};
 use crate::rapier::scene::{
-    expand_row, pair_material, topple_settings, BodySpec, Engine, PairLaw, Scene, SceneError,
-    SceneResult, ShapeKind, SolverSpec,
+    expand_row, pair_material, topple_settings, BodySpec, ImpactResponse, PairLaw, Scene,
+    SceneError, SceneResult, ShapeKind, SolverSpec,
 };
 
 /// A vector of this build from f64 components.
@@ -40,7 +40,7 @@ pub struct SceneWorld {
     /// The row, if the scene has one.
     pub row: Option<RowInfo>,
     /// Engine.
-    pub engine: Engine,
+    pub engine: ImpactResponse,
     /// Simulated time (s).
     pub time: f64,
 }
@@ -49,7 +49,7 @@ pub struct SceneWorld {
 ///
 /// ```
 /// use topple::rapier::f64::build;
-/// use topple::rapier::scene::{Engine, Scene};
+/// use topple::rapier::scene::{ImpactResponse, Scene};
 /// let scene: Scene = toml::from_str(r#"
 ///     duration = 0.1
 ///     [row]
@@ -57,12 +57,12 @@ pub struct SceneWorld {
 ///     n = 3
 ///     spacing = 0.35
 /// "#).unwrap();
-/// let mut sw = build(&scene, Engine::Rapier).unwrap();
+/// let mut sw = build(&scene, ImpactResponse::Topple).unwrap();
 /// assert_eq!(sw.bodies.len(), 3);
 /// sw.step();
 /// assert!(sw.kinetic_energy() > 0.0); // block 1 is pushed
 /// ```
-pub fn build(scene: &Scene, engine: Engine) -> SceneResult<SceneWorld> {
+pub fn build(scene: &Scene, engine: ImpactResponse) -> SceneResult<SceneWorld> {
     let mut scene = scene.clone();
     let row = match scene.row.clone() {
         Some(r) => Some(expand_row(&mut scene, &r)?),
@@ -71,8 +71,8 @@ pub fn build(scene: &Scene, engine: Engine) -> SceneResult<SceneWorld> {
     let mut world = rapier_world(&scene, row.as_ref())?;
     let length_unit = f64::from(world.integration_parameters.length_unit);
     let mut topple = match engine {
-        Engine::Rapier => ToppleRapier::new(topple_settings(&scene.solver, length_unit)),
-        Engine::RapierNative => ToppleRapier::native(),
+        ImpactResponse::Topple => ToppleRapier::new(topple_settings(&scene.solver, length_unit)),
+        ImpactResponse::Native => ToppleRapier::native(),
     };
     let ids = register_materials(&scene, &mut topple)?;
     let id = |name: &str| {

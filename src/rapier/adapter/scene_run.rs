@@ -7,7 +7,7 @@ use crate::domino::ChainReport;
 use super::scene_build::{build, SceneWorld};
 use crate::coupling::Resolution;
 use crate::rapier::scene::{
-    BodyState, Engine, RunOptions, Scene, SceneError, SceneOutput, SceneResult, TimedImpact,
+    BodyState, ImpactResponse, RunOptions, Scene, SceneError, SceneOutput, SceneResult, TimedImpact,
 };
 
 /// The group solved last by topple in the `topple impact` input format.
@@ -155,7 +155,7 @@ fn first_impact(sw: &SceneWorld, a: ColliderHandle, b: ColliderHandle) -> Option
 ///
 /// ```
 /// use topple::rapier::f64::run_scene;
-/// use topple::rapier::scene::{Engine, RunOptions, Scene};
+/// use topple::rapier::scene::{ImpactResponse, RunOptions, Scene};
 /// let scene: Scene = toml::from_str(r#"
 ///     duration = 0.01
 ///     gravity = [0.0, 0.0]
@@ -176,11 +176,15 @@ fn first_impact(sw: &SceneWorld, a: ColliderHandle, b: ColliderHandle) -> Option
 ///     mass = 1.0
 ///     material = "steel"
 /// "#).unwrap();
-/// let out = run_scene(&scene, Engine::Rapier, RunOptions::default()).unwrap();
+/// let out = run_scene(&scene, ImpactResponse::Topple, RunOptions::default()).unwrap();
 /// assert_eq!(out.impacts.len(), 1);
 /// assert!((out.bodies[1].velocity[0] - 1.0).abs() < 1e-3);
 /// ```
-pub fn run_scene(scene: &Scene, engine: Engine, options: RunOptions) -> SceneResult<SceneOutput> {
+pub fn run_scene(
+    scene: &Scene,
+    engine: ImpactResponse,
+    options: RunOptions,
+) -> SceneResult<SceneOutput> {
     let mut sw = build(scene, engine)?;
     let dt = f64::from(sw.world.integration_parameters.dt);
     let steps = (scene.duration / dt).round() as usize;

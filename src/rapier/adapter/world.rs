@@ -17,7 +17,7 @@ use super::pass::{ImpactContact, ImpactEvent, ImpactPass, Prediction, World};
 use super::scale;
 use super::support::{self, Notice};
 use crate::coupling::{ImpactGroups, ImpactReport, MaterialId, PairMaterial, ToppleSettings};
-use crate::rapier::{HookMode, ToppleStats};
+use crate::rapier::{ImpactResponse, ToppleStats};
 
 /// The world's length unit (Rapier's; 1 if it is not a positive number).
 fn length_unit(params: &IntegrationParameters) -> f64 {
@@ -131,17 +131,17 @@ pub struct ToppleRapier {
 impl ToppleRapier {
     /// topple resolving impacts with the given settings.
     pub fn new(settings: ToppleSettings) -> Self {
-        Self::with_mode(settings, HookMode::Topple)
+        Self::with_mode(settings, ImpactResponse::Topple)
     }
 
     /// A native-Rapier twin: the same per-pair friction and restitution, but
     /// Rapier resolves impacts and the impact pass does nothing. For
     /// comparisons.
     pub fn native() -> Self {
-        Self::with_mode(ToppleSettings::default(), HookMode::Native)
+        Self::with_mode(ToppleSettings::default(), ImpactResponse::Native)
     }
 
-    fn with_mode(settings: ToppleSettings, mode: HookMode) -> Self {
+    fn with_mode(settings: ToppleSettings, mode: ImpactResponse) -> Self {
         let mut topple = ToppleRapier {
             hooks: ToppleHooks::new(mode),
             settings,
@@ -392,7 +392,7 @@ impl ToppleRapier {
     /// sub-steps).
     fn substeps(&self, dt: f64) -> usize {
         match self.settings.max_substep {
-            Some(h) if self.hooks.mode == HookMode::Topple && h > 0.0 && dt > h => {
+            Some(h) if self.hooks.mode == ImpactResponse::Topple && h > 0.0 && dt > h => {
                 // a hair of tolerance so that 1/60 over 1/240 is 4, not 5
                 ((dt / h) * (1.0 - 1e-9)).ceil().min(1e3) as usize
             }
@@ -428,7 +428,7 @@ impl ToppleRapier {
     /// the bodies added since the last step).
     fn begin_piece(&mut self, parts: &StepParts<'_>) {
         self.record_start(parts.islands, parts.bodies);
-        if self.hooks.mode == HookMode::Topple {
+        if self.hooks.mode == ImpactResponse::Topple {
             for &b in &self.added {
                 self.pass.motion.record_added(parts.bodies, b);
             }
@@ -468,7 +468,7 @@ impl ToppleRapier {
     /// next managed pair closes, if any: none in native mode or once the
     /// step's budget is spent.
     fn predict(&mut self, parts: &StepParts<'_>, horizon: Real) -> Prediction {
-        if self.hooks.mode != HookMode::Topple || self.hooks.stand_aside || horizon <= 0.0 {
+        if self.hooks.mode != ImpactResponse::Topple || self.hooks.stand_aside || horizon <= 0.0 {
             return Prediction::default();
         }
         let start = Instant::now();
@@ -505,7 +505,7 @@ impl ToppleRapier {
     }
 
     fn record_start(&mut self, islands: &IslandManager, bodies: &RigidBodySet) {
-        if self.hooks.mode == HookMode::Topple {
+        if self.hooks.mode == ImpactResponse::Topple {
             let start = Instant::now();
             self.pass.motion.record_start(islands, bodies);
             self.stats.topple_seconds += start.elapsed().as_secs_f64();
@@ -546,7 +546,7 @@ impl ToppleRapier {
         integration_parameters: &IntegrationParameters,
         offset: f64,
     ) -> usize {
-        if self.hooks.mode != HookMode::Topple || self.hooks.stand_aside {
+        if self.hooks.mode != ImpactResponse::Topple || self.hooks.stand_aside {
             return 0;
         }
         let start = Instant::now();

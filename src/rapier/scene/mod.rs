@@ -8,7 +8,7 @@
 //! | [`Scene`] and its parts | `format.rs` | the TOML format (serde) |
 //! | [`SceneError`] | `error.rs` | why a scene could not be loaded, built or run |
 //! | [`expand_row`], [`row_params`] | `row.rs` | the `[row]` generator over [`crate::domino`]'s presets and ground models |
-//! | [`Engine`], [`SceneOutput`], [`row_scene`] | `setup.rs` | build-independent front: settings, materials, output |
+//! | [`SceneOutput`], [`row_scene`] | `setup.rs` | build-independent front: settings, materials, output |
 //! | [`run_scene`], [`run_row`] | `run.rs` | dispatch to the `f64` or `f32` build (each behind its cargo feature) |
 //! | [`check_scene`] | `check.rs` | a parsed scene's ranges, degenerate shapes, overlapping bodies |
 
@@ -19,6 +19,8 @@ mod row;
 mod run;
 mod setup;
 
+#[doc(no_inline)]
+pub use crate::rapier::ImpactResponse;
 pub use check::check_scene;
 pub use error::{SceneError, SceneResult};
 pub use format::{
@@ -31,6 +33,4 @@ pub use run::{run_row, run_scene};
 pub use setup::load_scene;
 #[cfg(any(feature = "f32", feature = "f64"))]
 pub(crate) use setup::pair_material;
-pub use setup::{
-    row_scene, topple_settings, BodyState, Engine, RunOptions, SceneOutput, TimedImpact,
-};
+pub use setup::{row_scene, topple_settings, BodyState, RunOptions, SceneOutput, TimedImpact};

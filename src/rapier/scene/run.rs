@@ -4,14 +4,15 @@
 //! settings and outputs the builds themselves use, so that no file imports
 //! one that imports it.
 
-use super::{Engine, RunOptions, Scene, SceneOutput, SceneResult, SolverSpec};
+use super::{RunOptions, Scene, SceneOutput, SceneResult, SolverSpec};
 use crate::domino::{ChainReport, RowSpec as DominoRow};
+use crate::rapier::ImpactResponse;
 use crate::rapier::Precision;
 
 /// Runs a scene with an engine on the Rapier build of `precision`.
 ///
 /// ```
-/// use topple::rapier::scene::{run_scene, Engine, RunOptions, Scene};
+/// use topple::rapier::scene::{run_scene, ImpactResponse, RunOptions, Scene};
 /// use topple::rapier::Precision;
 /// let scene: Scene = toml::from_str(r#"
 ///     duration = 0.01
@@ -34,14 +35,14 @@ use crate::rapier::Precision;
 ///     material = "steel"
 /// "#).unwrap();
 /// for precision in [Precision::F64, Precision::F32] {
-///     let out = run_scene(&scene, Engine::Rapier, precision, RunOptions::default()).unwrap();
+///     let out = run_scene(&scene, ImpactResponse::Topple, precision, RunOptions::default()).unwrap();
 ///     assert_eq!(out.impacts.len(), 1);
 ///     assert!((out.bodies[1].velocity[0] - 1.0).abs() < 1e-3);
 /// }
 /// ```
 pub fn run_scene(
     scene: &Scene,
-    engine: Engine,
+    engine: ImpactResponse,
     precision: Precision,
     options: RunOptions,
 ) -> SceneResult<SceneOutput> {
@@ -64,17 +65,17 @@ pub fn run_scene(
 ///
 /// ```
 /// use topple::domino::{Preset, RowSpec};
-/// use topple::rapier::scene::{run_row, Engine, SolverSpec};
+/// use topple::rapier::scene::{run_row, ImpactResponse, SolverSpec};
 /// use topple::rapier::Precision;
 /// let p = Preset::T.params().ideal();
 /// let row = RowSpec::new(p, 0.45 * p.block.height, 4, 1.0);
 /// let solver = SolverSpec { dt: 1.0 / 240.0, ..SolverSpec::default() };
-/// let r = run_row(&row, Engine::Rapier, Precision::F64, solver, 2.0, |_| {}).unwrap();
+/// let r = run_row(&row, ImpactResponse::Topple, Precision::F64, solver, 2.0, |_| {}).unwrap();
 /// assert_eq!(r.hit_times.len(), 4); // the wave reached the last block
 /// ```
 pub fn run_row(
     row: &DominoRow,
-    engine: Engine,
+    engine: ImpactResponse,
     precision: Precision,
     solver: SolverSpec,
     max_time: f64,
@@ -113,10 +114,15 @@ mod tests {
         let row = DominoRow::new(p, 0.45 * p.block.height, 2, 1.0);
         let solver = SolverSpec::default();
         for precision in [Precision::F32, Precision::F64] {
-            let s = run_scene(&scene, Engine::Rapier, precision, RunOptions::default());
+            let s = run_scene(
+                &scene,
+                ImpactResponse::Topple,
+                precision,
+                RunOptions::default(),
+            );
             let r = run_row(
                 &row,
-                Engine::RapierNative,
+                ImpactResponse::Native,
                 precision,
                 solver.clone(),
                 0.05,

@@ -3,37 +3,11 @@
 
 use crate::coupling::{FallbackPolicy, ImpactReport, PairMaterial, PatchRule, ToppleSettings};
 use crate::impact::{ContactMaterial, ImpactSettings};
+use crate::rapier::ImpactResponse;
 use crate::rapier::{Precision, ToppleStats};
 
 use super::format::{PairLaw, RowOverrides, RowSection, Scene, SolverSpec};
 use crate::domino::{ChainReport, RowSpec as DominoRow};
-
-/// Who resolves impacts.
-///
-/// ```
-/// use topple::rapier::scene::Engine;
-/// assert_eq!(Engine::RapierNative.name(), "rapier-native");
-/// ```
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Default, serde::Serialize)]
-#[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
-#[serde(rename_all = "kebab-case")]
-pub enum Engine {
-    /// Rapier with topple's LZB impacts and λ-point contact.
-    #[default]
-    Rapier,
-    /// Rapier alone (same materials per pair, Rapier's own restitution).
-    RapierNative,
-}
-
-impl Engine {
-    /// The name used on the command line and in JSON.
-    pub fn name(self) -> &'static str {
-        match self {
-            Engine::Rapier => "rapier",
-            Engine::RapierNative => "rapier-native",
-        }
-    }
-}
 
 /// The material of a pair rule (the adapters use it; without a Rapier build
 /// nothing does).
@@ -148,7 +122,7 @@ pub struct TimedImpact {
 #[derive(Clone, Debug, serde::Serialize)]
 pub struct SceneOutput {
     /// Engine used.
-    pub engine: Engine,
+    pub engine: ImpactResponse,
     /// Rapier build used.
     pub precision: Precision,
     /// Simulated time (s).

@@ -5,7 +5,7 @@
 use super::super::combo::SplitMix64;
 use crate::coupling::ToppleSettings;
 use crate::rapier::scene::{
-    BodySpec, Engine, GroundSpec, MaterialSpec, Scene, ShapeKind, SolverSpec, WorkBudget,
+    BodySpec, GroundSpec, ImpactResponse, MaterialSpec, Scene, ShapeKind, SolverSpec, WorkBudget,
 };
 use crate::rapier::Precision;
 
@@ -157,10 +157,10 @@ pub struct SceneCombo {
 
 impl SceneCombo {
     /// The topple engine of this combination (native for the baseline).
-    pub fn rapier_engine(&self) -> Engine {
+    pub fn rapier_engine(&self) -> ImpactResponse {
         match self.engine {
-            SceneEngine::Native => Engine::RapierNative,
-            _ => Engine::Rapier,
+            SceneEngine::Native => ImpactResponse::Native,
+            _ => ImpactResponse::Topple,
         }
     }
 

@@ -6,7 +6,7 @@ use std::time::Instant;
 
 use super::draw::SceneCombo;
 use crate::impact::audit::{self, AuditSummary};
-use crate::rapier::scene::{Engine, Scene};
+use crate::rapier::scene::{ImpactResponse, Scene};
 use crate::rapier::Precision;
 
 /// What one scene run shows, measured from the bodies' states and the
@@ -110,7 +110,7 @@ pub fn run_scene_combo(c: &SceneCombo, budget: f64) -> SceneObservation {
         seen.repeat_hash = (!again.over_budget).then_some(again.hash);
     }
     seen.wall = start.elapsed().as_secs_f64();
-    if c.rapier_engine() != Engine::RapierNative {
+    if c.rapier_engine() != ImpactResponse::Native {
         // the baseline on the same scene (its wall time is not the run's)
         let frames = (c.scene.duration / c.scene.solver.dt).round() as usize;
         let mut hooks = Hooks {
@@ -120,8 +120,8 @@ pub fn run_scene_combo(c: &SceneCombo, budget: f64) -> SceneObservation {
             ..Hooks::default()
         };
         let native = match c.precision {
-            Precision::F64 => on_f64::run(&c.scene, Engine::RapierNative, &mut hooks),
-            Precision::F32 => on_f32::run(&c.scene, Engine::RapierNative, &mut hooks),
+            Precision::F64 => on_f64::run(&c.scene, ImpactResponse::Native, &mut hooks),
+            Precision::F32 => on_f32::run(&c.scene, ImpactResponse::Native, &mut hooks),
         };
         seen.native = (native.error.is_none())
             .then_some((native.penetration, native.through_ground.is_some()));
@@ -153,7 +153,7 @@ macro_rules! watcher_for {
             use std::time::Instant;
 
             use super::{Fnv, Hooks, SceneObservation};
-            use crate::rapier::scene::{Engine, Scene};
+            use crate::rapier::scene::{ImpactResponse, Scene};
             use crate::rapier::$adapter::{build, signed_gap, SceneWorld};
             use crate::$backend::parry::bounding_volume::BoundingVolume;
             use crate::$backend::prelude::{ColliderHandle, RigidBodyHandle};
@@ -177,7 +177,7 @@ macro_rules! watcher_for {
             /// Runs `scene` with `engine` as `hooks` say.
             pub(crate) fn run(
                 scene: &Scene,
-                engine: Engine,
+                engine: ImpactResponse,
                 hooks: &mut Hooks,
             ) -> SceneObservation {
                 let mut seen = SceneObservation::default();
@@ -390,7 +390,7 @@ watcher_for!(on_f32, f32, rapier2d);
 /// impact checked.
 pub(crate) fn run_with(
     scene: &Scene,
-    engine: Engine,
+    engine: ImpactResponse,
     precision: Precision,
     hooks: &mut Hooks,
 ) -> SceneObservation {
