@@ -242,7 +242,7 @@ fn settings() -> Vec<(&'static str, ImpactSettings)> {
             limited(ImpactSettings::fixed(1e-4)),
         ),
         (
-            "adaptive impulse 10⁻⁴ (plugin default)",
+            "adaptive impulse 10⁻⁴",
             limited(ImpactSettings::adaptive_impulse(1e-4)),
         ),
         ("in time 10⁻⁴", limited(ImpactSettings::adaptive(1e-4))),
@@ -250,8 +250,29 @@ fn settings() -> Vec<(&'static str, ImpactSettings)> {
             "in time 2·10⁻⁶ (default)",
             limited(ImpactSettings::default()),
         ),
+        // the plugins' rest speed at 1/60 s under 9.81 m/s²: 0.01 of the
+        // impact threshold 2|g|Δt (docs/model.md §9)
+        (
+            "adaptive impulse 10⁻⁴, rest speed 3.3·10⁻³ m/s (plugin default)",
+            limited(ImpactSettings {
+                rest_speed: PLUGIN_REST_SPEED,
+                ..ImpactSettings::adaptive_impulse(1e-4)
+            }),
+        ),
+        (
+            "in time 2·10⁻⁶, rest speed 3.3·10⁻³ m/s",
+            limited(ImpactSettings {
+                rest_speed: PLUGIN_REST_SPEED,
+                ..ImpactSettings::default()
+            }),
+        ),
     ]
 }
+
+/// The rest speed the plugins give the resolver at 1/60 s under 9.81 m/s²
+/// (m/s): `ToppleSettings::DEFAULT_REST_FRACTION` · 2|g|Δt.
+const PLUGIN_REST_SPEED: f64 =
+    topple::coupling::ToppleSettings::DEFAULT_REST_FRACTION * 2.0 * 9.81 / 60.0;
 
 /// What one step control does on a class.
 struct Measured {
