@@ -213,16 +213,7 @@ impl PlasticSolver {
                     }
                 }
             }));
-        out.kinetic_energy_after = bodies
-            .iter()
-            .zip(&out.bodies)
-            .filter(|(b, _)| !b.fixed)
-            .map(|(b, v)| {
-                let [vx, vy] = v.velocity;
-                0.5 * b.mass * (vx * vx + vy * vy)
-                    + 0.5 * b.inertia * v.angular_velocity * v.angular_velocity
-            })
-            .sum();
+        out.set_kinetic_energy_after(bodies);
         out.contacts.clear();
         out.contacts
             .extend(self.impulse.iter().map(|&[pn, pt]| ContactImpulse {

@@ -2,7 +2,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use super::body::BodyVelocity;
+use super::body::{Body, BodyVelocity};
 
 /// Per-contact result of an impact.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
@@ -49,4 +49,21 @@ pub struct ImpactOutcome {
     pub rejected_steps: usize,
     /// Why the resolver stopped.
     pub stop_reason: Option<StopReason>,
+}
+
+impl ImpactOutcome {
+    /// Sets `kinetic_energy_after` from the velocities after: ½ m v² + ½ I ω²
+    /// of the free bodies (J), `bodies` giving their masses in the same order.
+    pub(crate) fn set_kinetic_energy_after(&mut self, bodies: &[Body]) {
+        self.kinetic_energy_after = bodies
+            .iter()
+            .zip(&self.bodies)
+            .filter(|(b, _)| !b.fixed)
+            .map(|(b, v)| {
+                let [vx, vy] = v.velocity;
+                0.5 * b.mass * (vx * vx + vy * vy)
+                    + 0.5 * b.inertia * v.angular_velocity * v.angular_velocity
+            })
+            .sum();
+    }
 }

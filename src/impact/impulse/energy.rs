@@ -8,24 +8,9 @@
 //! dt = ∫ dP_p / F_p(E_p) (the contact law, docs/model.md §1 and §7) and the
 //! gaps g += ∫ δ̇ dt of the contacts without energy.
 
-use super::data::{BodySlot, ContactState, ImpulseStepper, Row, Scratch};
-
-/// Gauss–Legendre nodes on [0, 1] and weights (4 points, exact for
-/// polynomials of degree 7).
-const GAUSS_4: [(f64, f64); 4] = [
-    (0.069_431_844_202_973_71, 0.173_927_422_568_726_93),
-    (0.330_009_478_207_571_87, 0.326_072_577_431_273_07),
-    (0.669_990_521_792_428_1, 0.326_072_577_431_273_07),
-    (0.930_568_155_797_026_3, 0.173_927_422_568_726_93),
-];
-
-/// A Gauss node s warped by σ = s^k: (s^k, k s^(k−1)).
-pub(super) type NodeWarp = (f64, f64);
-
-/// The Gauss nodes warped by σ = s^k (k = α + 1 of the contact law).
-pub(super) fn warped_nodes(k: f64) -> [NodeWarp; 4] {
-    GAUSS_4.map(|(node, _)| (node.powf(k), k * node.powf(k - 1.0)))
-}
+use super::data::{
+    warped_nodes, BodySlot, ContactState, ImpulseStepper, NodeWarp, Row, Scratch, GAUSS_4,
+};
 
 impl ImpulseStepper {
     /// Step 6: stored energies with the mid-step rate (see the file docs);

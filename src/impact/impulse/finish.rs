@@ -24,15 +24,6 @@ impl ImpulseStepper {
                 tangent_impulse: s.tangent_impulse,
                 peak_energy: s.peak_energy,
             }));
-        out.kinetic_energy_after = bodies
-            .iter()
-            .zip(&out.bodies)
-            .filter(|(b, _)| !b.fixed)
-            .map(|(b, v)| {
-                let [vx, vy] = v.velocity;
-                0.5 * b.mass * (vx * vx + vy * vy)
-                    + 0.5 * b.inertia * v.angular_velocity * v.angular_velocity
-            })
-            .sum();
+        out.set_kinetic_energy_after(bodies);
     }
 }

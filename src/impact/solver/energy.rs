@@ -32,7 +32,7 @@ impl Integrator {
                 tangent_impulse: self.y[lay.pt(i)],
                 peak_energy: row.law.energy(self.points[i].peak),
             }));
-        out.kinetic_energy_after = kinetic_energy(bodies, &out.bodies);
+        out.set_kinetic_energy_after(bodies);
         let kinematic = bodies
             .iter()
             .any(|b| b.fixed && (b.velocity != [0.0, 0.0] || b.angular_velocity != 0.0));
@@ -40,20 +40,6 @@ impl Integrator {
             guard(bodies, out);
         }
     }
-}
-
-/// ½ m v² + ½ I ω² of the free bodies (J).
-fn kinetic_energy(bodies: &[Body], after: &[BodyVelocity]) -> f64 {
-    bodies
-        .iter()
-        .zip(after)
-        .filter(|(b, _)| !b.fixed)
-        .map(|(b, v)| {
-            let [vx, vy] = v.velocity;
-            0.5 * b.mass * (vx * vx + vy * vy)
-                + 0.5 * b.inertia * v.angular_velocity * v.angular_velocity
-        })
-        .sum()
 }
 
 /// Scales every impulse so that the kinetic energy is not above its start
@@ -85,5 +71,5 @@ fn guard(bodies: &[Body], out: &mut ImpactOutcome) {
         c.normal_impulse *= s;
         c.tangent_impulse *= s;
     }
-    out.kinetic_energy_after = kinetic_energy(bodies, &out.bodies);
+    out.set_kinetic_energy_after(bodies);
 }
