@@ -310,15 +310,7 @@ fn materials(scene: &Scene) -> SceneResult<Vec<(String, PairMaterial, PairLaw)>>
                 m.name
             )));
         }
-        let law = PairLaw {
-            stiffness: m.stiffness,
-            exponent: m.exponent,
-            restitution: m.restitution,
-            friction: m.friction,
-            stick_friction: m.stick_friction,
-            impact_friction_factor: m.impact_friction_factor,
-            no_slip: false,
-        };
+        let law = m.law();
         out.push((m.name.clone(), pair_material(&law), law));
     }
     Ok(out)

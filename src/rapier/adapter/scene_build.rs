@@ -11,8 +11,8 @@ use super::backend::prelude::{
 use super::ToppleRapier;
 use crate::coupling::{ImpactReport, MaterialId};
 use crate::rapier::scene::{
-    expand_row, pair_material, topple_settings, BodySpec, ImpactResponse, PairLaw, Scene,
-    SceneError, SceneResult, ShapeKind, SolverSpec,
+    expand_row, pair_material, topple_settings, BodySpec, ImpactResponse, Scene, SceneError,
+    SceneResult, ShapeKind, SolverSpec,
 };
 
 /// A vector of this build from f64 components.
@@ -187,15 +187,7 @@ fn register_materials(
                 m.name
             )));
         }
-        let law = PairLaw {
-            stiffness: m.stiffness,
-            exponent: m.exponent,
-            restitution: m.restitution,
-            friction: m.friction,
-            stick_friction: m.stick_friction,
-            impact_friction_factor: m.impact_friction_factor,
-            no_slip: false,
-        };
+        let law = m.law();
         if ids
             .insert(m.name.clone(), topple.add_material(pair_material(&law)))
             .is_some()

@@ -77,18 +77,7 @@ pub fn check_scene(s: &Scene) -> Result<(), InputError> {
     }
     check_range("solver.closed_tolerance", v.closed_tolerance, 0.0, 1.0)?;
     for (i, m) in s.materials.iter().enumerate() {
-        law(
-            &format!("materials[{i}]"),
-            &PairLaw {
-                stiffness: m.stiffness,
-                exponent: m.exponent,
-                restitution: m.restitution,
-                friction: m.friction,
-                stick_friction: m.stick_friction,
-                impact_friction_factor: m.impact_friction_factor,
-                no_slip: false,
-            },
-        )?;
+        law(&format!("materials[{i}]"), &m.law())?;
     }
     for (i, p) in s.pairs.iter().enumerate() {
         law(&format!("pairs[{i}]"), &p.law)?;

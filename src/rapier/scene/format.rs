@@ -237,6 +237,30 @@ pub struct MaterialSpec {
     pub impact_friction_factor: f64,
 }
 
+impl MaterialSpec {
+    /// The material's law against itself (never no-slip): what a pair of
+    /// two bodies of this material takes unless a pair rule says otherwise.
+    ///
+    /// ```
+    /// use topple::rapier::scene::MaterialSpec;
+    /// let m: MaterialSpec = toml::from_str("name = \"wood\"\nstiffness = 1e8\nrestitution = 0.3").unwrap();
+    /// let law = m.law();
+    /// assert_eq!((law.stiffness, law.restitution, law.exponent), (1e8, 0.3, 1.5));
+    /// assert!(!law.no_slip);
+    /// ```
+    pub fn law(&self) -> PairLaw {
+        PairLaw {
+            stiffness: self.stiffness,
+            exponent: self.exponent,
+            restitution: self.restitution,
+            friction: self.friction,
+            stick_friction: self.stick_friction,
+            impact_friction_factor: self.impact_friction_factor,
+            no_slip: false,
+        }
+    }
+}
+
 fn default_exponent() -> f64 {
     1.5
 }
