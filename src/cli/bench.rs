@@ -6,7 +6,7 @@
 //!
 //! | run | meaning |
 //! | --- | --- |
-//! | `reference:paper` | reference engine, the paper's improved Euler at 10⁻⁴ s, impacts at the default adaptive impulse stepping (10⁻⁴) |
+//! | `reference:paper` | reference engine, the paper's improved Euler at 10⁻⁴ s, impacts at the resolver's default (time-domain, 2·10⁻⁶) |
 //! | `reference:paper:DT` | the same at time step DT (s) |
 //! | `reference:TOL` | reference engine, adaptive Dormand–Prince at tolerance TOL |
 //! | `reference:…:imp:TOL` | either of the above with adaptive impulse stepping at TOL |
@@ -299,7 +299,7 @@ fn file_name(run: &str) -> String {
 /// The default baseline: the reference run with the smallest tolerance, else
 /// the reference run with the smallest time step; among equals, the one with
 /// the smallest impact tolerance or impulse step (the default counts as
-/// [`Settings::IMPACT_TOLERANCE`]).
+/// [`StepControl::DEFAULT_TOLERANCE`]).
 fn default_baseline(kinds: &[(String, RunKind)]) -> Option<usize> {
     let key = |k: &RunKind| {
         let RunKind::Reference(integrator, control) = *k else {
@@ -309,7 +309,7 @@ fn default_baseline(kinds: &[(String, RunKind)]) -> Option<usize> {
             Some(StepControl::Adaptive { tolerance }) => tolerance,
             Some(StepControl::AdaptiveImpulse { tolerance }) => tolerance,
             Some(StepControl::Fixed { impulse_step }) => impulse_step,
-            None => Settings::IMPACT_TOLERANCE,
+            None => StepControl::DEFAULT_TOLERANCE,
         };
         Some(match integrator {
             Integrator::Adaptive { tolerance } => (0, tolerance, impacts),
@@ -404,8 +404,10 @@ pub fn run(args: Args) -> anyhow::Result<()> {
 fn family(kind: &RunKind) -> &'static str {
     match kind {
         RunKind::Reference(_, Some(StepControl::Fixed { .. })) => "reference, fixed impulse step",
-        RunKind::Reference(_, Some(StepControl::Adaptive { .. })) => "reference, impacts in time",
-        RunKind::Reference(..) => "reference, adaptive impulse step",
+        RunKind::Reference(_, Some(StepControl::AdaptiveImpulse { .. })) => {
+            "reference, adaptive impulse step"
+        }
+        RunKind::Reference(..) => "reference, impacts in time",
         RunKind::Rapier { .. } => "Rapier + topple",
         RunKind::Native { .. } => "native Rapier",
     }

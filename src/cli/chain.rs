@@ -152,12 +152,12 @@ pub struct Args {
     #[arg(long, allow_hyphen_values = true)]
     pub freeze_tolerance: Option<f64>,
     /// Reference engine: impacts with the paper's fixed impulse step
-    /// ΔP = STEP · P₀ (the paper: 10⁻⁴) instead of adaptive impulse
-    /// stepping.
+    /// ΔP = STEP · P₀ (the paper: 10⁻⁴) instead of the time-domain
+    /// resolver.
     #[arg(long, allow_hyphen_values = true)]
     pub impact_step: Option<f64>,
-    /// Reference engine: the tolerance of the adaptive impulse stepping
-    /// (default 10⁻⁴).
+    /// Reference engine: the tolerance of the time-domain impact resolver
+    /// (default 2·10⁻⁶, docs/model.md §7).
     #[arg(long, allow_hyphen_values = true, conflicts_with = "impact_step")]
     pub impact_tolerance: Option<f64>,
     /// Reference engine: make the heel of every block a contact on the front
@@ -361,7 +361,7 @@ fn reference_settings(args: &Args) -> Settings {
         settings.impact.step_control = StepControl::Fixed { impulse_step };
     }
     if let Some(tolerance) = args.impact_tolerance {
-        settings.impact.step_control = StepControl::AdaptiveImpulse { tolerance };
+        settings.impact.step_control = StepControl::Adaptive { tolerance };
     }
     settings.heel_contacts = args.heel_contacts;
     settings.series_blocks = args.series.clone();

@@ -37,7 +37,8 @@ impl Default for Integrator {
 /// let s = Settings::accurate(1e-8);
 /// assert_eq!(s.integrator, Integrator::Adaptive { tolerance: 1e-8 });
 /// assert_eq!(Settings::default().integrator, Integrator::Paper { dt: 1e-4 });
-/// // impacts: adaptive impulse stepping; the paper's fixed step on request
+/// // impacts: the time-domain resolver; the paper's fixed step on request
+/// assert_eq!(Settings::default().impact.step_control, topple::impact::StepControl::default());
 /// let paper = Settings::paper_impacts();
 /// assert_eq!(paper.impact.step_control, topple::impact::StepControl::Fixed { impulse_step: 1e-4 });
 /// ```
@@ -45,13 +46,15 @@ impl Default for Integrator {
 pub struct Settings {
     /// Time integration of the smooth phase.
     pub integrator: Integrator,
-    /// Impulse stepping of the impacts (default: adaptive at
-    /// [`Settings::IMPACT_TOLERANCE`], at most 2·10⁵ steps; the paper's fixed
-    /// ΔP = 10⁻⁴ P₀ with [`Settings::paper_impacts`]). On Domino X, Table 1,
-    /// s/h 0.52, 1,000 blocks the two give v̂_na 1.5310 and 1.5321, and
-    /// adaptive 10⁻⁵ 1.5316 (docs/reference-performance.md); the default
-    /// took a fifth of the fixed step's run time there. An impact that needs
-    /// more than its step limit is solved again with
+    /// How the impacts are resolved (default: the resolver's default, the
+    /// time-domain integration at [`crate::impact::StepControl::DEFAULT_TOLERANCE`],
+    /// docs/model.md §7, at most 2·10⁵ steps; the paper's fixed impulse step
+    /// ΔP = 10⁻⁴ P₀ with [`Settings::paper_impacts`]). On the rows of
+    /// docs/reference-performance.md it gives v̂_na within 0.05 % of a run
+    /// at 10⁻¹⁰ and runs 2–6 times faster than the adaptive impulse stepping
+    /// at 10⁻⁴ that was the default before it (the wedged e = 0 trains of the
+    /// ideal rows gain most). An impact that needs
+    /// more than `held_retry_after` steps is solved again with
     /// its e = 0 contacts held closed (counted in
     /// [`crate::domino::ChainReport::held_impacts`]); if that fails too it is
     /// resolved as plastic ([`crate::domino::ChainReport::impact_fallbacks`]).
@@ -88,12 +91,15 @@ pub struct Settings {
     /// projection to its unilateral form.
     #[serde(default)]
     pub heel_contacts: bool,
-    /// Impulse steps after which an impact that has e = 0 contacts and is
+    /// Resolver steps after which an impact that has e = 0 contacts and is
     /// still running under the paper's release-and-reload law is solved again
     /// with those contacts held closed (the limit of those cycles; counted as
-    /// `held_impacts`). 2·10⁴ changes v̂_na by 2·10⁻⁴ against waiting for the
-    /// full `impact.max_steps` (ideal T, s/h 0.3, 60 blocks) and runs 4×
-    /// faster; set it to `impact.max_steps` to give the paper's law every step.
+    /// `held_impacts`). Set it to `impact.max_steps` to give the paper's law
+    /// every step. With the adaptive impulse stepping, the default before the
+    /// time-domain resolver, 2·10⁴ changed v̂_na by 2·10⁻⁴ against waiting for
+    /// the full step limit (ideal T, s/h 0.3, 60 blocks) and ran 4× faster;
+    /// the time-domain resolver takes the fast cycles by their limit itself
+    /// ([`crate::impact::ImpactSettings::fast_cycle`]) and rarely gets here.
     pub held_retry_after: usize,
     /// Stop as soon as the last block is struck (the wave measures are then
     /// complete), or [`Settings::after_last_hit`] later; otherwise run until
@@ -129,7 +135,7 @@ impl Default for Settings {
             integrator: Integrator::default(),
             impact: ImpactSettings {
                 max_steps: 200_000,
-                ..ImpactSettings::adaptive_impulse(Self::IMPACT_TOLERANCE)
+                ..ImpactSettings::default()
             },
             gap_tolerance: 1e-6,
             velocity_tolerance: 1e-3,
@@ -155,9 +161,6 @@ fn is_zero(x: &f64) -> bool {
 }
 
 impl Settings {
-    /// The default tolerance of the adaptive impulse stepping (relative to
-    /// the approach speed, see [`crate::impact::StepControl::AdaptiveImpulse`]).
-    pub const IMPACT_TOLERANCE: f64 = 1e-4;
     /// The default freeze tolerance (see [`Settings::freeze_tolerance`]).
     pub const FREEZE_TOLERANCE: f64 = 1e-2;
 

@@ -137,7 +137,7 @@ fn the_plot_has_a_series_per_engine_and_changed_settings_rerun() {
     let plot = std::fs::read_to_string(&svg).unwrap();
     assert!(plot.starts_with("<svg"), "{}", &plot[..80.min(plot.len())]);
     // the baseline is the only fixed-step run, so that series is empty
-    assert!(plot.contains("reference, adaptive impulse step"));
+    assert!(plot.contains("reference, impacts in time"));
     assert!(plot.contains("native Rapier"));
     assert!(!plot.contains("reference, fixed impulse step"));
 

@@ -42,14 +42,12 @@ pub struct Args {
     /// in steps of 0.05).
     #[arg(long, allow_hyphen_values = true, value_delimiter = ',')]
     pub spacings: Vec<f64>,
-    /// The tolerance of the adaptive impulse stepping of the impacts
-    /// (default 10⁻⁴; ideal Domino T, s/h 0.45, 30 blocks: v̂_na 1.776038
-    /// at 10⁻⁴ and at 10⁻⁶ against 1.7760 with the paper's fixed step, 5
-    /// times faster).
+    /// The tolerance of the time-domain impact resolver (default 2·10⁻⁶,
+    /// docs/model.md §7).
     #[arg(long)]
     pub impact_tolerance: Option<f64>,
     /// Impacts with the paper's fixed impulse step ΔP = STEP · P₀ (the
-    /// paper: 10⁻⁴) instead of adaptive impulse stepping.
+    /// paper: 10⁻⁴) instead of the time-domain resolver.
     #[arg(long, conflicts_with = "impact_tolerance")]
     pub impact_step: Option<f64>,
     /// Wall-clock limit per run (s); a run that hits it keeps the blocks it
@@ -97,7 +95,7 @@ fn base_settings(args: &Args) -> Settings {
     };
     base.wall_time_limit = Some(args.run_limit);
     if let Some(tolerance) = args.impact_tolerance {
-        base.impact.step_control = StepControl::AdaptiveImpulse { tolerance };
+        base.impact.step_control = StepControl::Adaptive { tolerance };
     }
     if let Some(impulse_step) = args.impact_step {
         base.impact.step_control = StepControl::Fixed { impulse_step };

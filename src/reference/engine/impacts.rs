@@ -214,7 +214,7 @@ impl Engine {
     /// Step 4: the solve, by the coupling layer's policy
     /// ([`crate::coupling::GroupSolver`], the same code as the Rapier
     /// adapter's): the paper's LZB law; for a group with e = 0 contacts
-    /// that has not finished after `held_retry_after` impulse steps (a
+    /// that has not finished after `held_retry_after` resolver steps (a
     /// wedged group whose e = 0 contacts release and reload in ever smaller
     /// cycles), again with those contacts held closed, their limit (counted
     /// as a held impact); if that fails too, or an outcome would create

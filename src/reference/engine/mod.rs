@@ -242,7 +242,7 @@ impl Engine {
 }
 
 /// The fallback policy with the reference's own budgets: the held retry
-/// after `held_retry_after` impulse steps, every attempt within the
+/// after `held_retry_after` resolver steps, every attempt within the
 /// resolver's step limit.
 /// Any other budget of the policy stays at its default.
 #[allow(clippy::needless_update)] // the policy may gain budgets
