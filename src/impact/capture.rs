@@ -51,20 +51,6 @@ pub fn finish() -> Vec<CapturedImpact> {
 
 /// Records an impact if this thread is recording.
 pub(crate) fn record(bodies: &[Body], contacts: &[Contact], settings: &ImpactSettings) {
-    if let Ok(path) = std::env::var("SCRATCH_STREAM") {
-        use std::io::Write;
-        let c = CapturedImpact {
-            bodies: bodies.to_vec(),
-            contacts: contacts.to_vec(),
-            settings: *settings,
-        };
-        let mut f = std::fs::OpenOptions::new()
-            .create(true)
-            .append(true)
-            .open(path)
-            .unwrap();
-        writeln!(f, "{}", serde_json::to_string(&c).unwrap()).unwrap();
-    }
     CAPTURE.with(|c| {
         if let Some(list) = c.borrow_mut().as_mut() {
             list.push(CapturedImpact {
