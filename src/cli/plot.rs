@@ -25,6 +25,9 @@ pub enum Style {
     Markers,
     /// Filled circles joined by a thin line.
     MarkersLine,
+    /// Open circles at the points: simulation points to be read with care
+    /// (in `topple paper`'s sweeps, a wave still speeding up at the row's end).
+    Open,
     /// A solid line.
     Line,
     /// A dashed line.
@@ -87,7 +90,7 @@ pub fn plot(
         .unwrap_or(0) as f64;
     let (fw, fh) = (
         (40.0 + 7.0 * width) / 650.0,
-        (14.0 + 20.0 * curves.len() as f64) / 390.0,
+        (14.0 + 20.0 * curves.iter().filter(|c| !c.name.is_empty()).count() as f64) / 390.0,
     );
     let inside = |left: bool, top: bool| -> usize {
         let (bx0, bx1) = if left {
@@ -203,10 +206,17 @@ fn draw(
                         .map_err(|e| anyhow::anyhow!("{e}"))?;
                 }
             }
+            let marker = |p| match c.style {
+                Style::Open => Circle::new(p, 3, col.stroke_width(1)),
+                _ => Circle::new(p, 3, col.filled()),
+            };
             let anno = chart
-                .draw_series(pts.iter().map(|&p| Circle::new(p, 3, col.filled())))
+                .draw_series(pts.iter().map(|&p| marker(p)))
                 .map_err(|e| anyhow::anyhow!("{e}"))?;
-            label_series(anno, &c.name, c.style, col);
+            // a curve without a name adds points to an entry already shown
+            if !c.name.is_empty() {
+                label_series(anno, &c.name, c.style, col);
+            }
         }
     }
     chart
@@ -231,6 +241,8 @@ fn label_series<'a, DB: DrawingBackend + 'a>(
     anno.label(name).legend(move |(x, y)| {
         if style.is_line() {
             PathElement::new(vec![(x, y), (x + 20, y)], line).into_dyn()
+        } else if style == Style::Open {
+            Circle::new((x + 10, y), 3, col.stroke_width(1)).into_dyn()
         } else {
             Circle::new((x + 10, y), 3, col.filled()).into_dyn()
         }

@@ -92,6 +92,29 @@ pub fn fig5_lines() -> Vec<TheoryLine> {
     ]
 }
 
+/// Whether a row's wave is no longer speeding up at the row's end: v̂_i of
+/// the last ten blocks before the last two (the end of the row slows its
+/// last blocks) rises by less than [`STEADY_RISE`] of their mean from the
+/// first of them to the last. A row too short to have twelve speeds does
+/// not count as steady.
+pub fn wave_is_steady(speeds: &[f64]) -> bool {
+    let n = speeds.len();
+    if n < 12 {
+        return false;
+    }
+    let tail = &speeds[n - 12..n - 2];
+    let mean = tail.iter().sum::<f64>() / tail.len() as f64;
+    let rise = tail[tail.len() - 1] - tail[0];
+    mean.is_finite() && rise.is_finite() && rise < STEADY_RISE * mean
+}
+
+/// Largest relative rise of v̂_i over the tail of a steady wave
+/// ([`wave_is_steady`]): 1 %, about the scatter of v̂_i of a row whose wave
+/// is steady (ideal rows: 0.01–0.03 of v̂_na, docs/reference-performance.md)
+/// and well below the 15 % by which a wave still speeding up lags behind
+/// the cooperative model at s/h 0.1.
+pub const STEADY_RISE: f64 = 0.01;
+
 /// `fig5_ground`: the cooperative and extended (μ = [`GROUND_MU1`]) lines,
 /// grey, since the six point colours include black and blue.
 pub fn ground_lines() -> Vec<TheoryLine> {
@@ -204,19 +227,34 @@ impl Figures<'_> {
         let mut names = keys(&v);
         let mut rows = Vec::new();
         let mut curves = Vec::new();
+        let mut unsteady = Vec::new();
         for (ki, k) in names.iter().enumerate() {
             let runs = v.iter().filter(|(j, _)| &j.key == k);
-            let pts: Vec<(f64, f64)> = runs
+            let colour = COLOURS[ki % COLOURS.len()];
+            let (steady, rising): (Vec<_>, Vec<_>) = runs
                 .clone()
-                .map(|(j, r)| (j.x, r.natural_speed.unwrap_or(f64::NAN)))
-                .collect();
+                .map(|(j, r)| {
+                    (
+                        j.x,
+                        r.natural_speed.unwrap_or(f64::NAN),
+                        wave_is_steady(&r.speeds),
+                    )
+                })
+                .partition(|p| p.2);
             rows.extend(runs.map(|(j, r)| {
                 let spread = r.natural_speed_spread.map_or(f64::NAN, |s| s.std_dev);
-                vec![ki as f64, j.x, r.natural_speed.unwrap_or(f64::NAN), spread]
+                let steady = if wave_is_steady(&r.speeds) { 1.0 } else { 0.0 };
+                vec![
+                    ki as f64,
+                    j.x,
+                    r.natural_speed.unwrap_or(f64::NAN),
+                    spread,
+                    steady,
+                ]
             }));
             curves.push(Curve {
                 name: k.trim_start_matches(sub).trim().to_string(),
-                points: pts,
+                points: steady.iter().map(|p| (p.0, p.1)).collect(),
                 // with theory lines the simulations are points; alone, the
                 // points of a parameter sweep are joined to show the trend
                 style: if lines.is_empty() {
@@ -224,9 +262,26 @@ impl Figures<'_> {
                 } else {
                     Style::Markers
                 },
-                colour: None,
+                colour: Some(colour),
+            });
+            unsteady.extend(rising.iter().map(|p| (p.0, p.1, colour)));
+        }
+        // rows whose wave still speeds up at their end: v̂_na is below the
+        // steady speed the theory lines give (open circles, one legend entry)
+        if !unsteady.is_empty() {
+            curves.push(Curve {
+                name: "open: wave still speeding up at the row's end".to_string(),
+                points: Vec::new(),
+                style: Style::Open,
+                colour: Some(COLOURS[5]),
             });
         }
+        curves.extend(unsteady.into_iter().map(|(x, y, colour)| Curve {
+            name: String::new(),
+            points: vec![(x, y)],
+            style: Style::Open,
+            colour: Some(colour),
+        }));
         let grid = theory_grid(&v.iter().map(|(j, _)| j.x).collect::<Vec<_>>());
         for line in lines {
             let ki = names.len() as f64;
@@ -237,7 +292,7 @@ impl Figures<'_> {
             rows.extend(
                 pts.iter()
                     .filter(|p| p.1.is_finite())
-                    .map(|(x, y)| vec![ki, *x, *y, f64::NAN]),
+                    .map(|(x, y)| vec![ki, *x, *y, f64::NAN, 1.0]),
             );
             curves.push(Curve {
                 name: line.name.clone(),
@@ -246,7 +301,7 @@ impl Figures<'_> {
                 colour: Some(line.colour),
             });
         }
-        let header = format!("curve({}),x,v_na,v_na_std", names.join("|"));
+        let header = format!("curve({}),x,v_na,v_na_std,steady", names.join("|"));
         csv(&self.out.join(format!("{name}.csv")), &header, &rows)?;
         plot(
             &self.out.join(format!("{name}.svg")),
@@ -335,4 +390,33 @@ fn theory_points(line: &TheoryLine, grid: &[f64]) -> anyhow::Result<Vec<(f64, f6
             (r.spacing_ratio, y)
         })
         .collect())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::wave_is_steady;
+
+    /// v̂_i = v∞ (1 − a e^(−i/L)): a wave that settles over L blocks.
+    fn settling(n: usize, length: f64) -> Vec<f64> {
+        (0..n)
+            .map(|i| 2.0 * (1.0 - 0.3 * (-(i as f64) / length).exp()))
+            .collect()
+    }
+
+    #[test]
+    fn a_wave_that_settles_within_the_row_is_steady_and_a_rising_one_is_not() {
+        // 40 blocks, settling over 5: the tail rises by 0.6 e^(−28/5) (1 − e^(−9/5)) ≈ 1.8·10⁻³, 0.09 %
+        assert!(wave_is_steady(&settling(40, 5.0)));
+        // settling over 20 blocks: the tail still rises by 0.6 (e^(−1.4) − e^(−1.85)) ≈ 0.054, 2.8 %
+        assert!(!wave_is_steady(&settling(40, 20.0)));
+        // a wave slowing down at the end is not "speeding up"
+        let mut slowing = vec![2.0; 40];
+        for (i, v) in slowing.iter_mut().enumerate().skip(28) {
+            *v -= 0.01 * (i - 28) as f64;
+        }
+        assert!(wave_is_steady(&slowing));
+        // too short to tell, or not finite
+        assert!(!wave_is_steady(&[2.0; 11]));
+        assert!(!wave_is_steady(&[f64::INFINITY; 20]));
+    }
 }
