@@ -27,7 +27,7 @@ use std::time::Instant;
 
 use bevy::prelude::*;
 use bevy_rapier2d::prelude::*;
-use scenes::{Physics, Target};
+use scenes::Target;
 use topple::bevy::{headless_row_app, DominoRow, ImpactResponse, ToppleFrameStats};
 use topple::domino::{Preset, RowSpec};
 
@@ -133,7 +133,7 @@ fn with_budget(app: &mut App) {
 }
 
 fn pixel_scene(
-    physics: Physics,
+    physics: ImpactResponse,
     frames: usize,
     ground_y: f32,
     spawn: impl FnOnce(&mut Commands, Target),
@@ -206,8 +206,8 @@ fn main() {
         let spawn = |c: &mut Commands, t: Target| {
             scenes::pyramid(c, t, 10, 40.0);
         };
-        let native = pixel_scene(Physics::Native, f, ground, spawn);
-        let topple = pixel_scene(Physics::Topple, f, ground, spawn);
+        let native = pixel_scene(ImpactResponse::Native, f, ground, spawn);
+        let topple = pixel_scene(ImpactResponse::Topple, f, ground, spawn);
         print("pyramid at rest, 55 boxes, px", f, &native, &topple);
     }
     if want("pile") {
@@ -215,8 +215,8 @@ fn main() {
         let spawn = |c: &mut Commands, t: Target| {
             scenes::pile_in_layers(c, t, 10, 15);
         };
-        let native = pixel_scene(Physics::Native, f, ground, spawn);
-        let topple = pixel_scene(Physics::Topple, f, ground, spawn);
+        let native = pixel_scene(ImpactResponse::Native, f, ground, spawn);
+        let topple = pixel_scene(ImpactResponse::Topple, f, ground, spawn);
         print(
             "pile of 150 boxes dropped in layers, px",
             f,
@@ -229,8 +229,8 @@ fn main() {
         let spawn = |c: &mut Commands, t: Target| {
             scenes::bin(c, t, 48);
         };
-        let native = pixel_scene(Physics::Native, f, ground, spawn);
-        let topple = pixel_scene(Physics::Topple, f, ground, spawn);
+        let native = pixel_scene(ImpactResponse::Native, f, ground, spawn);
+        let topple = pixel_scene(ImpactResponse::Topple, f, ground, spawn);
         print(
             "48 balls, boxes, capsules, polygons in a bin, px",
             f,
@@ -249,8 +249,8 @@ fn main() {
         let spawn = |c: &mut Commands, t: Target| {
             show::domino_show(c, t, 16);
         };
-        let native = pixel_scene(Physics::Native, f, ground, spawn);
-        let topple = pixel_scene(Physics::Topple, f, ground, spawn);
+        let native = pixel_scene(ImpactResponse::Native, f, ground, spawn);
+        let topple = pixel_scene(ImpactResponse::Topple, f, ground, spawn);
         print("domino_show, 16 fronts, px", f, &native, &topple);
     }
 }

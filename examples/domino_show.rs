@@ -24,14 +24,15 @@ use std::path::PathBuf;
 
 use bevy::prelude::*;
 use bevy_rapier2d::prelude::*;
-use common::scenes::{Physics, Piece, Role, DT, PPM};
+use common::scenes::{label, other, Piece, Role, DT, PPM};
 use common::show::{domino_show, ShowLayout, FRONT_H};
 use common::view::{self, Contexts, Hud, Meter, HEIGHT, UPRIGHT_ANGLE, WIDTH};
+use topple::bevy::ImpactResponse;
 use topple::bevy::{rapier_plugin, ToppleFrameStats, TopplePlugin};
 
 #[derive(Resource)]
 struct Show {
-    physics: Physics,
+    physics: ImpactResponse,
     fronts: usize,
     layout: Option<ShowLayout>,
     screenshot: Option<(PathBuf, u32)>,
@@ -40,7 +41,7 @@ struct Show {
 
 fn parse_args() -> Result<Show, String> {
     let mut show = Show {
-        physics: Physics::Topple,
+        physics: ImpactResponse::Topple,
         fronts: 6,
         layout: None,
         screenshot: None,
@@ -52,7 +53,7 @@ fn parse_args() -> Result<Show, String> {
         let mut value = || it.next().ok_or_else(|| format!("{flag} needs a value"));
         match flag.as_str() {
             "--fronts" => show.fronts = value()?.parse().map_err(|e| format!("--fronts: {e}"))?,
-            "--native" => show.physics = Physics::Native,
+            "--native" => show.physics = ImpactResponse::Native,
             "--screenshot" => file = Some(PathBuf::from(value()?)),
             "--frames" => frames = value()?.parse().map_err(|e| format!("--frames: {e}"))?,
             other => {
@@ -118,7 +119,7 @@ fn keys(
         return;
     }
     if switch {
-        show.physics = show.physics.other();
+        show.physics = other(show.physics);
     }
     for e in &pieces {
         commands.entity(e).despawn();
@@ -166,9 +167,9 @@ fn hud(
         .collect();
     text.0 = format!(
         "domino show, {}: {} fronts, dominoes growing 1.5x into a tower, a row down steps   [N] {} [R] restart\n{}\ndown: fronts {}/{}   growing {}/{}   tower {}/{}   steps {}/{}",
-        show.physics.name(),
+        label(show.physics),
         show.fronts,
-        show.physics.other().name(),
+        label(other(show.physics)),
         meter.line(&stats),
         toppled(&fronts, &transforms),
         fronts.len(),
@@ -234,7 +235,7 @@ fn fronts_json(
             continue; // off the window
         }
         rows.push(serde_json::json!({
-            "row": show.physics.name(),
+            "row": label(show.physics),
             "n": row.dominoes.len(),
             "upright": upright,
             "toppled": angles.len() - upright,
@@ -244,8 +245,8 @@ fn fronts_json(
             "band_top": top.max(0.0).round(),
             "band_bottom": bottom.min(HEIGHT as f32 - 1.0).round(),
             "toppled_rgb": match show.physics {
-                Physics::Topple => [242, 140, 38],
-                Physics::Native => [64, 140, 242],
+                ImpactResponse::Topple => [242, 140, 38],
+                ImpactResponse::Native => [64, 140, 242],
             },
         }));
     }

@@ -20,13 +20,14 @@ use std::path::PathBuf;
 
 use bevy::prelude::*;
 use bevy_rapier2d::prelude::*;
-use common::scenes::{pour_body, pour_ground, Lcg, Physics, Piece, DT, PPM};
+use common::scenes::{label, other, pour_body, pour_ground, Lcg, Piece, DT, PPM};
 use common::view::{self, Contexts, Hud, Meter};
+use topple::bevy::ImpactResponse;
 use topple::bevy::{rapier_plugin, ToppleFrameStats, TopplePlugin};
 
 #[derive(Resource)]
 struct Pour {
-    physics: Physics,
+    physics: ImpactResponse,
     bodies: usize,
     poured: usize,
     started: bool,
@@ -37,7 +38,7 @@ struct Pour {
 
 fn parse_args() -> Result<Pour, String> {
     let mut pour = Pour {
-        physics: Physics::Topple,
+        physics: ImpactResponse::Topple,
         bodies: 200,
         poured: 0,
         started: false,
@@ -51,7 +52,7 @@ fn parse_args() -> Result<Pour, String> {
         let mut value = || it.next().ok_or_else(|| format!("{flag} needs a value"));
         match flag.as_str() {
             "--bodies" => pour.bodies = value()?.parse().map_err(|e| format!("--bodies: {e}"))?,
-            "--native" => pour.physics = Physics::Native,
+            "--native" => pour.physics = ImpactResponse::Native,
             "--screenshot" => file = Some(PathBuf::from(value()?)),
             "--frames" => frames = value()?.parse().map_err(|e| format!("--frames: {e}"))?,
             other => {
@@ -117,7 +118,7 @@ fn keys(
         return;
     }
     if switch {
-        pour.physics = pour.physics.other();
+        pour.physics = other(pour.physics);
     }
     for e in &pieces {
         commands.entity(e).despawn();
@@ -156,10 +157,10 @@ fn hud(
     };
     text.0 = format!(
         "boxes and balls poured onto a ramp, {}: {}/{} poured   [N] {} [R] pour again\n{}",
-        pour.physics.name(),
+        label(pour.physics),
         pour.poured,
         pour.bodies,
-        pour.physics.other().name(),
+        label(other(pour.physics)),
         meter.line(&stats),
     );
 }

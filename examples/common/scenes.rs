@@ -25,29 +25,20 @@ pub const G: f32 = 9.81 * PPM;
 /// The physics step (s).
 pub const DT: f32 = 1.0 / 60.0;
 
-/// Who resolves the scene's impacts.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
-pub enum Physics {
-    /// topple's LZB impacts.
-    #[default]
-    Topple,
-    /// bevy_rapier alone.
-    Native,
+/// The HUD's name of who resolves a scene's impacts: topple's LZB impacts,
+/// or bevy_rapier alone.
+pub fn label(physics: ImpactResponse) -> &'static str {
+    match physics {
+        ImpactResponse::Topple => "topple",
+        ImpactResponse::Native => "native",
+    }
 }
 
-impl Physics {
-    pub fn name(self) -> &'static str {
-        match self {
-            Physics::Topple => "topple",
-            Physics::Native => "native",
-        }
-    }
-
-    pub fn other(self) -> Physics {
-        match self {
-            Physics::Topple => Physics::Native,
-            Physics::Native => Physics::Topple,
-        }
+/// The other one (what the switching key selects).
+pub fn other(physics: ImpactResponse) -> ImpactResponse {
+    match physics {
+        ImpactResponse::Topple => ImpactResponse::Native,
+        ImpactResponse::Native => ImpactResponse::Topple,
     }
 }
 
@@ -55,7 +46,7 @@ impl Physics {
 /// context).
 #[derive(Clone, Copy, Debug, Default)]
 pub struct Target {
-    pub physics: Physics,
+    pub physics: ImpactResponse,
     pub context: Option<Entity>,
 }
 
@@ -138,10 +129,10 @@ impl Mat {
 /// coefficients (averaged between two colliders, Rapier's default rule).
 pub fn material(e: &mut EntityCommands, target: Target, m: Mat) {
     match target.physics {
-        Physics::Topple => {
+        ImpactResponse::Topple => {
             e.insert(ToppleMaterial(m.topple()));
         }
-        Physics::Native => {
+        ImpactResponse::Native => {
             e.insert((
                 Friction::coefficient(m.friction as f32),
                 Restitution::coefficient(m.restitution as f32),
@@ -156,11 +147,8 @@ pub fn material(e: &mut EntityCommands, target: Target, m: Mat) {
 /// A headless app in pixel units stepping one context at 1/60 s per
 /// `update()`, deterministic, with the default context stepped by topple or
 /// by bevy_rapier, and topple's default settings.
-pub fn headless_app(physics: Physics) -> App {
-    let who = match physics {
-        Physics::Topple => ImpactResponse::Topple,
-        Physics::Native => ImpactResponse::Native,
-    };
+pub fn headless_app(physics: ImpactResponse) -> App {
+    let who = physics;
     let mut app = App::new();
     app.add_plugins((MinimalPlugins, TransformPlugin))
         .add_plugins((

@@ -8,7 +8,8 @@ use bevy::prelude::*;
 use bevy_rapier2d::prelude::*;
 use topple::bevy::ToppleFrameStats;
 
-use super::scenes::{Physics, Piece, PieceShape, Role, Target, PPM};
+use super::scenes::{Piece, PieceShape, Role, Target, PPM};
+use topple::bevy::ImpactResponse;
 
 pub const WIDTH: u32 = 1280;
 pub const HEIGHT: u32 = 720;
@@ -44,12 +45,12 @@ pub struct Contexts {
 
 impl Contexts {
     /// Where a scene of the given physics goes.
-    pub fn target(&self, physics: Physics) -> Target {
+    pub fn target(&self, physics: ImpactResponse) -> Target {
         Target {
             physics,
             context: match physics {
-                Physics::Topple => None,
-                Physics::Native => Some(self.native),
+                ImpactResponse::Topple => None,
+                ImpactResponse::Native => Some(self.native),
             },
         }
     }
@@ -179,10 +180,13 @@ pub fn decorate(
 }
 
 /// Dominoes upright grey, toppled in the colour of their physics.
-pub fn colour_dominoes(physics: Physics, mut dominoes: Query<(&Transform, &Piece, &mut Sprite)>) {
+pub fn colour_dominoes(
+    physics: ImpactResponse,
+    mut dominoes: Query<(&Transform, &Piece, &mut Sprite)>,
+) {
     let toppled = match physics {
-        Physics::Topple => TOPPLED_TOPPLE,
-        Physics::Native => TOPPLED_NATIVE,
+        ImpactResponse::Topple => TOPPLED_TOPPLE,
+        ImpactResponse::Native => TOPPLED_NATIVE,
     };
     for (t, piece, mut sprite) in &mut dominoes {
         if piece.role == Role::Domino {

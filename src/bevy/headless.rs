@@ -10,6 +10,7 @@ use bevy_rapier2d::prelude::*;
 
 use super::plugin::{rapier_plugin, TopplePlugin};
 use super::row::DominoRow;
+use crate::input::InputError;
 
 /// An app without window or renderer (MinimalPlugins, transforms,
 /// bevy_rapier and topple) stepping the row's context at a fixed `dt` (s),
@@ -27,9 +28,9 @@ use super::row::DominoRow;
 /// let state = app.world().get::<DominoRowState>(id).unwrap();
 /// assert_eq!(state.hit_times().len(), 4); // the wave reached block 4
 /// ```
-pub fn headless_row_app(row: &DominoRow, dt: f64) -> Result<(App, Entity), String> {
+pub fn headless_row_app(row: &DominoRow, dt: f64) -> Result<(App, Entity), InputError> {
     if !(dt.is_finite() && dt > 0.0) {
-        return Err(format!("dt must be > 0 and finite (got {dt})"));
+        return Err(InputError::new("dt", dt, "0 < dt, finite (s)"));
     }
     row.spec.validate()?;
     let init = RapierContextInitialization::InitializeDefaultRapierContext {

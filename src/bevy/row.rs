@@ -10,6 +10,7 @@ use super::world::{PhysicsClock, ToppleConfig, ToppleMaterial};
 use crate::coupling::PairMaterial;
 use crate::coupling::ToppleSettings;
 use crate::domino::{ChainReport, RowSpec};
+use crate::input::InputError;
 use crate::rapier::f32::{integration_parameters, signed_gap, HitTracker};
 use crate::rapier::scene::{
     expand_row, pair_material, row_scene, topple_settings, PairLaw, SolverSpec,
@@ -114,7 +115,7 @@ impl DominoRow {
     /// A topple row also adds its pair rules to [`ToppleConfig`]. The row
     /// must be valid ([`RowSpec::validate`]); an invalid one is refused with
     /// its message and nothing is spawned.
-    pub fn spawn(&self, commands: &mut Commands) -> Result<Entity, String> {
+    pub fn spawn(&self, commands: &mut Commands) -> Result<Entity, InputError> {
         self.spec.validate()?;
         let (block_law, ground_law) = self.laws();
         let (block, ground) = (pair_material(&block_law), pair_material(&ground_law));

@@ -11,6 +11,7 @@ use bevy_rapier2d::rapier::prelude::IntegrationParameters;
 use super::row::DominoRowState;
 use super::world::{ToppleConfig, ToppleMaterial};
 use crate::coupling::{PairMaterial, ToppleSettings};
+use crate::input::InputError;
 use crate::rapier::f32::{integration_parameters, HitTracker};
 use crate::rapier::scene::{
     expand_row, pair_material, topple_settings, BodySpec, PairLaw, Scene, SceneError, SceneResult,
@@ -153,13 +154,14 @@ impl<'a> SceneSpawn<'a> {
     /// first (`topple::rapier::scene::check_scene`); a bad one is refused with its
     /// message and nothing is spawned.
     pub fn spawn(&self, commands: &mut Commands) -> SceneResult<SpawnedScene> {
-        crate::rapier::scene::check_scene(self.scene)
-            .map_err(|e| SceneError::invalid(e.to_string()))?;
+        crate::rapier::scene::check_scene(self.scene)?;
         if !(self.scale.is_finite() && self.scale > 0.0) {
-            return Err(SceneError::invalid(format!(
-                "scale = {}: must be > 0 and finite",
-                self.scale
-            )));
+            return Err(InputError::new(
+                "scale",
+                self.scale,
+                "0 < scale, finite (units per metre)",
+            )
+            .into());
         }
         let mut scene = self.scene.clone();
         let row = match scene.row.clone() {

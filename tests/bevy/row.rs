@@ -112,7 +112,8 @@ fn bad_rows_are_refused_with_a_message() {
     let mut bad = spec(10);
     bad.spacing = -1.0;
     let e = headless_row_app(&DominoRow::new(bad), DT).unwrap_err();
-    assert!(e.contains("spacing"), "{e}");
+    assert!(e.field.contains("spacing"), "{e}");
+    assert_eq!(e.value, "-1");
     let e = headless_row_app(&DominoRow::new(spec(10)), 0.0).unwrap_err();
-    assert!(e.contains("dt"), "{e}");
+    assert_eq!((e.field.as_str(), e.value.as_str()), ("dt", "0"), "{e}");
 }

@@ -12,13 +12,13 @@ use bevy::prelude::*;
 use bevy::time::TimeUpdateStrategy;
 use bevy_rapier2d::plugin::RapierContextInitialization;
 use bevy_rapier2d::prelude::*;
-use scenes::{Physics, Target};
-use topple::bevy::{rapier_plugin, SceneSpawn, ToppleFrameStats, TopplePlugin};
+use scenes::Target;
+use topple::bevy::{rapier_plugin, ImpactResponse, SceneSpawn, ToppleFrameStats, TopplePlugin};
 use topple::rapier::scene::Scene;
 
 /// Each box's position (px) and angle after `frames` frames of the 10-level
 /// pyramid of 40 px boxes, with the frame statistics summed.
-fn pyramid(physics: Physics, frames: usize) -> (Vec<(Vec2, f32)>, ToppleFrameStats) {
+fn pyramid(physics: ImpactResponse, frames: usize) -> (Vec<(Vec2, f32)>, ToppleFrameStats) {
     let mut app = scenes::headless_app(physics);
     let mut boxes = Vec::new();
     scenes::spawn_in(&mut app, |c| {
@@ -57,8 +57,8 @@ fn pyramid(physics: Physics, frames: usize) -> (Vec<(Vec2, f32)>, ToppleFrameSta
 #[test]
 fn pixel_pyramid_at_rest_has_no_impacts_and_stands_as_native() {
     let frames = 180;
-    let (native, _) = pyramid(Physics::Native, frames);
-    let (topple, stats) = pyramid(Physics::Topple, frames);
+    let (native, _) = pyramid(ImpactResponse::Native, frames);
+    let (topple, stats) = pyramid(ImpactResponse::Topple, frames);
     // the default threshold follows the scene (2|g|Δt in pixels): resting
     // contacts are not impacts
     assert_eq!(stats.impacts, 0, "{stats:?}");
@@ -176,9 +176,9 @@ fn a_scene_file_in_metres_and_in_pixels_gives_the_same_motion() {
 /// `ToppleNotice`, and impacts go on after the despawns.
 #[test]
 fn despawns_sensors_and_kinematic_bodies_in_a_pile() {
-    let mut app = scenes::headless_app(Physics::Topple);
+    let mut app = scenes::headless_app(ImpactResponse::Topple);
     let target = Target {
-        physics: Physics::Topple,
+        physics: ImpactResponse::Topple,
         context: None,
     };
     let mut boxes = Vec::new();

@@ -15,3 +15,4 @@ mod sleeping;
 mod soak;
 mod stress_checks;
 mod vs_reference;
+mod warm_start;

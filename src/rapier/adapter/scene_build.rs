@@ -10,6 +10,7 @@ use super::backend::prelude::{
 };
 use super::ToppleRapier;
 use crate::coupling::{ImpactReport, MaterialId};
+use crate::input::InputError;
 use crate::rapier::scene::{
     expand_row, pair_material, topple_settings, BodySpec, ImpactResponse, Scene, SceneError,
     SceneResult, ShapeKind, SolverSpec,
@@ -124,13 +125,28 @@ fn rapier_world(scene: &Scene, row: Option<&DominoRow>) -> SceneResult<PhysicsWo
     let length_unit = s
         .length_unit
         .unwrap_or(row.map_or(1.0, |spec| spec.params.block.height));
-    if !(s.dt > 0.0 && length_unit > 0.0 && scene.duration >= 0.0) {
-        return Err(SceneError::invalid(
-            "dt and length_unit must be > 0 and duration >= 0",
-        ));
+    let positive = |field: &str, x: f64, allowed: &str| {
+        if x > 0.0 && x.is_finite() {
+            Ok(())
+        } else {
+            Err(InputError::new(field, x, allowed))
+        }
+    };
+    positive("solver.dt", s.dt, "0 < solver.dt, finite (s)")?;
+    positive(
+        "solver.length_unit",
+        length_unit,
+        "0 < solver.length_unit, finite (m)",
+    )?;
+    if scene.duration.is_nan() || scene.duration < 0.0 {
+        return Err(InputError::new("duration", scene.duration, "0 ≤ duration (s)").into());
     }
-    if s.contact_hertz.is_some_and(|f| !(f > 0.0 && f.is_finite())) {
-        return Err(SceneError::invalid("contact_hertz must be > 0 and finite"));
+    if let Some(f) = s.contact_hertz {
+        positive(
+            "solver.contact_hertz",
+            f,
+            "0 < solver.contact_hertz, finite (Hz)",
+        )?;
     }
     let hertz = s
         .contact_hertz

@@ -4,7 +4,7 @@
 
 use super::super::hooks::ToppleHooks;
 use super::super::motion::Path;
-use crate::coupling::{FallbackPolicy, ToppleSettings};
+use crate::coupling::{FallbackPolicy, Resolution, ToppleSettings};
 
 use super::{
     body_index, dynamic_parent, v2, ImpactContact, ImpactEvent, ImpactPass, World, NO_SLOT,
@@ -44,7 +44,19 @@ impl ImpactPass {
                 0,
             );
         }
-        self.expand_group(world, hooks, settings, t);
+        // once the step's budget is spent, an impact is the closing pair
+        // alone (and the walls it touches): its plastic solve stays small,
+        // and Rapier's contact solver takes the neighbours as native Rapier
+        // would (docs/bevy.md, "Bounded frames")
+        let window = ToppleSettings {
+            max_group_hops: if self.work_left == Some(0) {
+                Some(0)
+            } else {
+                settings.max_group_hops
+            },
+            ..*settings
+        };
+        self.expand_group(world, hooks, &window, t);
         self.contact_points += self.contacts.len() as u64;
         // the impacts of a step share its work budget
         let budgeted = ToppleSettings {
@@ -59,8 +71,15 @@ impl ImpactPass {
             .resolve(&mut self.bodies, &self.contacts, &budgeted);
         let work = self.groups.work();
         self.work += work;
+        // the plastic fallback's sweeps (each over the impact's contact
+        // points) spend the budget too, though they are not LZB work
+        let sweeps: u64 = self.groups.reports()[..groups]
+            .iter()
+            .filter(|r| r.resolution == Resolution::Plastic)
+            .map(|r| (r.steps * r.contacts) as u64)
+            .sum();
         if let Some(left) = &mut self.work_left {
-            *left = left.saturating_sub(work);
+            *left = left.saturating_sub(work + sweeps);
         }
         self.record(offset + t, groups);
         for h in &self.handles {
