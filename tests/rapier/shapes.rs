@@ -195,14 +195,7 @@ fn every_shape_on_every_ground_stays_out_of_it() {
     for (gname, ground) in grounds() {
         for (bname, body) in bodies() {
             let (_, _, _, depth) = drop(ground.clone(), body);
-            // known (not yet mended): the trapezoid's third bounce on a
-            // segment, at 0.5 m/s from a gap within Rapier's prediction
-            // distance, is resolved at the end of its step, 0.0100 m deep
-            let limit = if (bname, gname) == ("convex polygon", "segment") {
-                0.0101
-            } else {
-                0.01
-            };
+            let limit = 0.01;
             if depth >= limit {
                 failures.push(format!("{bname} on {gname}: {depth} m into the ground"));
             }

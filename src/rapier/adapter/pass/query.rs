@@ -104,7 +104,10 @@ impl ImpactPass {
             self.manifolds.push(ContactManifold::new());
         }
         let m = &mut self.manifolds[0];
-        m.clear();
+        // a fresh manifold: parry starts its GJK from the normal a reused one
+        // kept (`local_n1`), which made the result depend on the pair and
+        // instant queried before
+        *m = ContactManifold::new();
         let ok = DefaultQueryDispatcher
             .contact_manifold_convex_convex(&pos12, s1, s2, None, None, reach, m);
         if swap {
