@@ -33,12 +33,16 @@ pub fn run_combo(c: &Combo, budget: f64) -> Observation {
     // first meets its neighbour near π/4 (s/h near 0.6) rebounds off it, a
     // leaning train at small spacing rocks about its rest angle near π/4.
     // The same row in the reference engine decides (after the audit: its
-    // impacts are not this run's). It runs up to the last hit, so a drop
-    // after it stays counted.
+    // impacts are not this run's): a drop it shows too, or a rock-back
+    // across π/4 no larger than one of its own fallen blocks makes, is
+    // physics (the Rapier rows are perturbed, the reference's is not; near
+    // π/4 that decides which side of it a rebound ends). It runs up to the
+    // last hit, so a drop after it stays counted.
     if seen.fallen_drop > 0 && c.engine != StressEngine::Reference {
         let oracle = reference(c, budget);
-        seen.reference_fallen_drop =
-            (oracle.error.is_none() && !oracle.over_budget).then_some(oracle.fallen_drop);
+        let ran = oracle.error.is_none() && !oracle.over_budget;
+        seen.reference_fallen_drop = ran.then_some(oracle.fallen_drop);
+        seen.reference_rock_back = ran.then_some(oracle.fallen_rock_back);
     }
     seen
 }

@@ -38,6 +38,19 @@ pub struct Observation {
     /// For a Rapier run whose fallen count dropped: the largest drop of the
     /// same row in the reference engine (`None` if it could not be run).
     pub reference_fallen_drop: Option<usize>,
+    /// Largest rock-back (rad) of a block once past [`FALLEN_TILT`]: its
+    /// largest tilt so far less its tilt now, over every look. A block
+    /// that strikes its neighbour rebounds (Table 1's e1 reverses the
+    /// striker, the paper's reversed blocks), by a degree or two.
+    pub fallen_rock_back: f64,
+    /// The same, only for blocks whose rock-back took them back below
+    /// [`FALLEN_TILT`] (0 if none did): how far a block that stood up
+    /// again had come back from its largest tilt.
+    pub stood_up_rock_back: f64,
+    /// For a Rapier run whose fallen count dropped: the reference engine's
+    /// [`Observation::fallen_rock_back`] on the same row (`None` if it could
+    /// not be run).
+    pub reference_rock_back: Option<f64>,
     /// Blocks hit by the wave.
     pub hits: usize,
     /// The run did not end within its budget (its engine's own limits or the
@@ -72,6 +85,8 @@ pub struct RowWatch {
     /// The last looks, oldest first (for `Observation::deepest`).
     recent: std::collections::VecDeque<(f64, Vec<[f64; 3]>)>,
     last_fallen: Option<usize>,
+    /// Largest tilt (rad, absolute) of every block so far.
+    peak: Vec<f64>,
     looks: usize,
     /// What has been seen so far.
     pub seen: Observation,
@@ -86,6 +101,7 @@ impl RowWatch {
             reach: h.hypot(d),
             recent: std::collections::VecDeque::new(),
             last_fallen: None,
+            peak: Vec::new(),
             looks: 0,
             seen: Observation::default(),
         }
@@ -130,6 +146,18 @@ impl RowWatch {
             self.seen.deepest = self.moments();
         }
         let fallen = blocks.iter().filter(|b| b[2].abs() > FALLEN_TILT).count();
+        self.peak.resize(blocks.len(), 0.0);
+        for (b, peak) in blocks.iter().zip(&mut self.peak) {
+            let tilt = b[2].abs();
+            *peak = peak.max(tilt);
+            if *peak > FALLEN_TILT {
+                let back = *peak - tilt;
+                self.seen.fallen_rock_back = self.seen.fallen_rock_back.max(back);
+                if tilt <= FALLEN_TILT {
+                    self.seen.stood_up_rock_back = self.seen.stood_up_rock_back.max(back);
+                }
+            }
+        }
         if let Some(last) = self.last_fallen {
             let drop = last.saturating_sub(fallen);
             if drop > 0 && self.seen.dropped.is_empty() {

@@ -193,8 +193,13 @@ pub fn violations(c: &Combo, o: &Observation) -> Vec<Violation> {
     } else {
         pen_tol
     };
-    // a drop the reference shows on the same row too is physics
-    let fallen_drop = if dissipative && o.reference_fallen_drop.is_none_or(|d| d == 0) {
+    // a drop the reference shows on the same row too is physics, and so is
+    // a block rocking back across π/4 by no more than a fallen block rocks
+    // back in the reference on the same row (see `run_combo`)
+    let as_reference = o.reference_fallen_drop.is_some_and(|d| d > 0)
+        || o.reference_rock_back
+            .is_some_and(|r| o.stood_up_rock_back <= r);
+    let fallen_drop = if dissipative && !as_reference {
         o.fallen_drop as f64
     } else {
         0.0

@@ -83,6 +83,17 @@ fn overlap_and_a_fallen_block_standing_up_are_seen() {
     w.look(0.0, &[[0.0, 0.05, -1.0]]);
     w.look(0.0, &[[0.0, 0.05, 0.0]]);
     assert_eq!(w.seen.fallen_drop, 1);
+    // it came back 1 rad from its largest tilt
+    assert_eq!(w.seen.stood_up_rock_back, 1.0);
+    assert_eq!(w.seen.fallen_rock_back, 1.0);
+    // a block rebounding from 0.8 rad to 0.78 (across π/4 = 0.7854), and
+    // one from 1.2 to 1.1 rad (still fallen)
+    let mut w = RowWatch::new(0.1, 0.02);
+    w.look(0.0, &[[0.0, 0.05, -0.8], [0.2, 0.05, -1.2]]);
+    w.look(0.1, &[[0.0, 0.05, -0.78], [0.2, 0.05, -1.1]]);
+    assert_eq!(w.seen.fallen_drop, 1);
+    assert!((w.seen.stood_up_rock_back - 0.02).abs() < 1e-12);
+    assert!((w.seen.fallen_rock_back - 0.1).abs() < 1e-12);
     let mut w = RowWatch::new(0.1, 0.02);
     w.look(0.0, &[[0.0, f64::NAN, 0.0]]);
     assert!(w.seen.non_finite);
@@ -244,4 +255,38 @@ fn a_scene_frame_stays_within_its_budget_and_f32_impulses_rebuild_the_velocities
         assert!(v.iter().all(|v| v.kind != topple::stress::Kind::Impulses));
     }
     assert!(checked > 0, "some impacts were checked");
+}
+
+/// Combo 536 of `topple stress --full --seed 1` (Rapier f64, Domino X, s/h
+/// 0.572, e1 0.85, 1/240 s): block 2, at 46.3° when it strikes block 3,
+/// rebounds (ω 23.4 → −2.0 rad/s) to 44.9° two steps later, a rock-back of
+/// 1.4° that crosses π/4 by 0.1°: the fallen count drops by one. The same
+/// row in the reference engine (unperturbed) keeps its count, but its own
+/// fallen blocks rock back by up to 2.5° after passing π/4 (block 1),
+/// coming back to 45.05° (measured with snapshots every 2 ms at Δt 0.1 ms).
+/// A rebound of the reference's size across π/4 is physics (the Rapier
+/// row's perturbations decide the side); a larger one is counted.
+#[test]
+fn a_rebound_across_a_quarter_turn_no_larger_than_the_references_is_physics() {
+    let c = draw(1, 536, 3, 20);
+    assert_eq!(c.engine, StressEngine::RapierF64);
+    let o = run_combo(&c, 600.0);
+    assert_eq!(o.fallen_drop, 1, "{o:?}");
+    let back = o.stood_up_rock_back.to_degrees();
+    assert!((0.5..3.0).contains(&back), "rock-back {back}°");
+    let reference = o.reference_rock_back.expect("the reference ran");
+    println!(
+        "rock-back across π/4 {back:.3}°, the reference's largest past π/4 {:.3}°",
+        reference.to_degrees()
+    );
+    assert!(reference >= o.stood_up_rock_back);
+    assert!(violations(&c, &o)
+        .iter()
+        .all(|v| v.kind != Kind::FallenDrop));
+    // had the reference's blocks rocked back half as far, it would count
+    let mut larger = o.clone();
+    larger.reference_rock_back = Some(0.5 * o.stood_up_rock_back);
+    assert!(violations(&c, &larger)
+        .iter()
+        .any(|v| v.kind == Kind::FallenDrop));
 }
