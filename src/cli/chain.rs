@@ -471,7 +471,13 @@ fn block_ranges(blocks: &[usize]) -> String {
     let shown: Vec<String> = runs
         .iter()
         .take(RANGES_SHOWN)
-        .map(|&(a, b)| if a == b { a.to_string() } else { format!("{a}–{b}") })
+        .map(|&(a, b)| {
+            if a == b {
+                a.to_string()
+            } else {
+                format!("{a}–{b}")
+            }
+        })
         .collect();
     let more = match runs.len().saturating_sub(RANGES_SHOWN) {
         0 => String::new(),
