@@ -1,18 +1,23 @@
 #!/usr/bin/env bash
-# The crate packages (`cargo package --no-verify`: every file the build, the
-# doctests and the tests read is in the .crate, Cargo.toml's metadata is
-# complete), and the dependency lines README.md and docs/bevy.md give users
-# resolve against that package: a stand-in project with each line (the
-# registry version replaced by the unpacked .crate's path) runs `cargo tree`.
-# The Bevy line must pull in one Rapier build (rapier2d, not rapier2d-f64)
-# and no command-line crate. Nothing is compiled; resolving uses the
-# registry index already fetched (`--offline`).
+# The crate packages and the packaged sources build: `cargo package` with its
+# verify step, which unpacks the .crate and builds it, here without default
+# features (the library alone: serde, serde_json, thiserror; well under a
+# minute cold). The verify step builds in the `dev` profile, which nothing
+# else in CI uses, so verifying the default features (both Rapier builds,
+# clap, plotters) would compile them all a second time, minutes on two cores;
+# docs/ci.md has the figures and the command. Cargo.toml's metadata is
+# complete (cargo package warns otherwise). Then the dependency lines
+# README.md and docs/bevy.md give users resolve against that package: a
+# stand-in project with each line (the registry version replaced by the
+# unpacked .crate's path) runs `cargo tree`. The Bevy line must pull in one
+# Rapier build (rapier2d, not rapier2d-f64) and no command-line crate.
+# Resolving uses the registry index already fetched (`--offline`).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 TARGET_DIR=${TARGET_DIR:-$(.ci/target_dir.sh)}
 
 version=$(sed -n 's/^version = "\(.*\)"/\1/p' Cargo.toml | head -1)
-cargo package --locked --no-verify --allow-dirty --quiet
+cargo package --locked --no-default-features --allow-dirty --quiet
 crate="$TARGET_DIR/package/topple-$version.crate"
 [ -s "$crate" ] || { echo "no $crate after cargo package"; exit 1; }
 size=$(stat -c %s "$crate")

@@ -342,10 +342,10 @@ impl Crate {
             for g in &module.globs {
                 let mut t = g.clone();
                 t.extend_from_slice(&path[k..]);
-                if let Some(f) = self.resolve(&t, depth + 1) {
-                    if self.files[&f].module != path[..k] {
-                        return Some(f);
-                    }
+                if let Some(f) = self.resolve(&t, depth + 1)
+                    && self.files[&f].module != path[..k]
+                {
+                    return Some(f);
                 }
             }
         }
@@ -404,10 +404,10 @@ fn edges(c: &Crate) -> BTreeMap<PathBuf, BTreeSet<PathBuf>> {
                 continue; // a path built inside a macro: not resolved
             }
             let r: Vec<String> = r.into_iter().filter(|s| s != "*").collect();
-            if let Some(target) = c.resolve(&r, 0) {
-                if &target != path {
-                    out.insert(target);
-                }
+            if let Some(target) = c.resolve(&r, 0)
+                && &target != path
+            {
+                out.insert(target);
             }
         }
     }
@@ -547,14 +547,14 @@ fn top_level_modules_use_only_the_layers_above_them() {
     for (from, to) in edges(&krate) {
         let Some((a, ia)) = rank(&from) else { continue };
         for t in to {
-            if let Some((b, ib)) = rank(&t) {
-                if ib > ia {
-                    wrong.push(format!(
-                        "{} ({a}) uses {} ({b})",
-                        from.display(),
-                        t.display()
-                    ));
-                }
+            if let Some((b, ib)) = rank(&t)
+                && ib > ia
+            {
+                wrong.push(format!(
+                    "{} ({a}) uses {} ({b})",
+                    from.display(),
+                    t.display()
+                ));
             }
         }
     }

@@ -125,23 +125,23 @@ fn parse_run(run: &str, default: Precision) -> anyhow::Result<RunKind> {
         parts.pop();
     }
     let precision = named.unwrap_or(default);
-    if let ["reference", head @ .., "imp", stepping] = parts.as_slice() {
-        if !head.is_empty() {
-            let smooth = format!("reference:{}", head.join(":"));
-            let control = if *stepping == "fixed" {
-                StepControl::paper()
-            } else if let Some(tol) = stepping.strip_prefix("time-") {
-                StepControl::Adaptive {
-                    tolerance: number(tol, "impact tolerance", run)?,
-                }
-            } else {
-                StepControl::AdaptiveImpulse {
-                    tolerance: number(stepping, "impact tolerance", run)?,
-                }
-            };
-            if let RunKind::Reference(integrator, None) = parse_run(&smooth, default)? {
-                return Ok(RunKind::Reference(integrator, Some(control)));
+    if let ["reference", head @ .., "imp", stepping] = parts.as_slice()
+        && !head.is_empty()
+    {
+        let smooth = format!("reference:{}", head.join(":"));
+        let control = if *stepping == "fixed" {
+            StepControl::paper()
+        } else if let Some(tol) = stepping.strip_prefix("time-") {
+            StepControl::Adaptive {
+                tolerance: number(tol, "impact tolerance", run)?,
             }
+        } else {
+            StepControl::AdaptiveImpulse {
+                tolerance: number(stepping, "impact tolerance", run)?,
+            }
+        };
+        if let RunKind::Reference(integrator, None) = parse_run(&smooth, default)? {
+            return Ok(RunKind::Reference(integrator, Some(control)));
         }
     }
     Ok(match parts.as_slice() {

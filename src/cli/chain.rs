@@ -434,17 +434,57 @@ fn run_reference(args: &Args, row: &RowSpec) -> anyhow::Result<()> {
     }
     print_report(r, args.row.spacing_ratio, row);
     println!(
-        "impacts {} ({} with e = 0 contacts held, {} plastic fallbacks), max penetration {:.3e} m, blocks turning back: {:?}, simulated {:.4} s in {:.3} s ({} steps)",
+        "impacts {} ({} with e = 0 contacts held, {} plastic fallbacks), max penetration {:.3e} m, blocks turning back: {}, simulated {:.4} s in {:.3} s ({} steps)",
         r.impacts,
         r.held_impacts,
         r.impact_fallbacks,
         r.max_penetration.unwrap_or(0.0),
-        r.reversed_blocks,
+        block_ranges(&r.reversed_blocks),
         r.simulated_time,
         r.run_time,
         out.steps
     );
     budget_end(r, row, args.wall_limit)
+}
+
+/// Ranges of consecutive blocks shown before the rest is summed up.
+const RANGES_SHOWN: usize = 8;
+
+/// A set of block indices for a person to read: their count and their runs
+/// of consecutive indices, "999 blocks (1–999)", "4 blocks (2, 5–7)",
+/// "none"; past [`RANGES_SHOWN`] runs the rest is counted, not listed
+/// (`--json` keeps the full list).
+fn block_ranges(blocks: &[usize]) -> String {
+    let mut sorted = blocks.to_vec();
+    sorted.sort_unstable();
+    sorted.dedup();
+    let Some(&first) = sorted.first() else {
+        return "none".to_string();
+    };
+    let mut runs: Vec<(usize, usize)> = vec![(first, first)];
+    for &b in &sorted[1..] {
+        match runs.last_mut() {
+            Some(run) if b == run.1 + 1 => run.1 = b,
+            _ => runs.push((b, b)),
+        }
+    }
+    let shown: Vec<String> = runs
+        .iter()
+        .take(RANGES_SHOWN)
+        .map(|&(a, b)| {
+            if a == b {
+                a.to_string()
+            } else {
+                format!("{a}–{b}")
+            }
+        })
+        .collect();
+    let more = match runs.len().saturating_sub(RANGES_SHOWN) {
+        0 => String::new(),
+        k => format!(" and {k} more ranges"),
+    };
+    let noun = if sorted.len() == 1 { "block" } else { "blocks" };
+    format!("{} {noun} ({}{more})", sorted.len(), shown.join(", "))
 }
 
 /// The θ, θ̇ series of `topple chain --series` as CSV.
@@ -542,6 +582,21 @@ fn theory_line(p: &RowParams, spacing_ratio: f64) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn block_ranges_count_and_join_consecutive_blocks() {
+        let row: Vec<usize> = (1..1000).collect();
+        assert_eq!(block_ranges(&row), "999 blocks (1–999)");
+        assert_eq!(block_ranges(&[]), "none");
+        assert_eq!(block_ranges(&[7]), "1 block (7)");
+        assert_eq!(block_ranges(&[9, 2, 5, 6, 7, 6]), "5 blocks (2, 5–7, 9)");
+        // every other block: 20 runs of one, 8 listed
+        let sparse: Vec<usize> = (0..20).map(|k| 2 * k).collect();
+        assert_eq!(
+            block_ranges(&sparse),
+            "20 blocks (0, 2, 4, 6, 8, 10, 12, 14 and 12 more ranges)"
+        );
+    }
 
     #[test]
     fn theory_picks_the_model_whose_assumptions_hold() {

@@ -104,10 +104,10 @@ pub fn for_each_contact_point(
     let mut first: Option<[f64; 2]> = None;
     for p in points.iter().filter(|p| closed(p)) {
         // Two coincident closed points are one contact.
-        if let Some(q) = first {
-            if (p.point[0] - q[0]).hypot(p.point[1] - q[1]) <= rule.min_patch_length {
-                continue;
-            }
+        if let Some(q) = first
+            && (p.point[0] - q[0]).hypot(p.point[1] - q[1]) <= rule.min_patch_length
+        {
+            continue;
         }
         first = Some(p.point);
         emit(p.point, p.dist);

@@ -136,14 +136,14 @@ impl Model {
                 "finite and mu ≥ 0 (friction coefficient)",
             )));
         }
-        if let Model::Single { e, .. } = *self {
-            if !(0.0..=1.0).contains(&e) {
-                return Err(TheoryError::InvalidParameter(InputError::new(
-                    "e",
-                    e,
-                    "0 ≤ e ≤ 1 (coefficient of restitution)",
-                )));
-            }
+        if let Model::Single { e, .. } = *self
+            && !(0.0..=1.0).contains(&e)
+        {
+            return Err(TheoryError::InvalidParameter(InputError::new(
+                "e",
+                e,
+                "0 ≤ e ≤ 1 (coefficient of restitution)",
+            )));
         }
         Ok(())
     }

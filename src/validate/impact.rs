@@ -64,24 +64,24 @@ pub fn impact(bodies: &[Body], contacts: &[Contact]) -> Result<(), InputError> {
             check_range(&format!("contacts[{i}].point[{k}]"), c.point[k], -m, m)?;
         }
         for (k, body) in c.bodies.iter().enumerate() {
-            if let Some(b) = body {
-                if *b >= bodies.len() {
-                    return Err(InputError::new(
-                        format!("contacts[{i}].bodies[{k}]"),
-                        b,
-                        format!("a body index < {} or null (the fixed world)", bodies.len()),
-                    ));
-                }
-            }
-        }
-        if let [Some(a), Some(b)] = c.bodies {
-            if a == b {
+            if let Some(b) = body
+                && *b >= bodies.len()
+            {
                 return Err(InputError::new(
-                    format!("contacts[{i}].bodies"),
-                    format!("[{a}, {b}]"),
-                    "two different bodies",
+                    format!("contacts[{i}].bodies[{k}]"),
+                    b,
+                    format!("a body index < {} or null (the fixed world)", bodies.len()),
                 ));
             }
+        }
+        if let [Some(a), Some(b)] = c.bodies
+            && a == b
+        {
+            return Err(InputError::new(
+                format!("contacts[{i}].bodies"),
+                format!("[{a}, {b}]"),
+                "two different bodies",
+            ));
         }
         let len = c.normal[0].hypot(c.normal[1]);
         if !(len.is_finite() && (len - 1.0).abs() <= 1e-6) {

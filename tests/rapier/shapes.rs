@@ -133,11 +133,11 @@ fn drop_at(
     for _ in 0..60 {
         topple.step(&mut w);
         notices.extend(topple.take_notices());
-        if ratio.is_none() {
-            if let Some(r) = topple.last_impacts().first() {
-                ratio = Some(r.kinetic_energy_after / r.kinetic_energy_before);
-                spin = w.bodies[b].angvel().abs();
-            }
+        if ratio.is_none()
+            && let Some(r) = topple.last_impacts().first()
+        {
+            ratio = Some(r.kinetic_energy_after / r.kinetic_energy_before);
+            spin = w.bodies[b].angvel().abs();
         }
         let aabb = w.colliders[c].compute_aabb();
         lowest = lowest.min(aabb.mins.y);

@@ -81,73 +81,117 @@ fn no_slip_contact_in_an_impact_is_a_pivot() {
 /// 0.6 at block 5, 2.05 at 25, 2.245 at 50; v̂_na of 80 blocks 2.046 against
 /// a steady 2.250). So the test also checks that v̂_i has stopped rising
 /// where it is measured.
-#[test]
-fn no_slip_ideal_row_runs_at_the_cooperative_speed() {
-    let base = Preset::T.params().ideal();
-    let mut p = base;
+///
+/// One test per spacing (s/h, blocks), so that libtest runs them on all
+/// cores; each checks the same as the others.
+mod no_slip_ideal_row_runs_at_the_cooperative_speed {
+    #[test]
+    fn sh_0_1() {
+        super::no_slip_ideal_row_at(0.1, 70);
+    }
+    #[test]
+    fn sh_0_2() {
+        super::no_slip_ideal_row_at(0.2, 50);
+    }
+    #[test]
+    fn sh_0_3() {
+        super::no_slip_ideal_row_at(0.3, 40);
+    }
+    #[test]
+    fn sh_0_4() {
+        super::no_slip_ideal_row_at(0.4, 30);
+    }
+    #[test]
+    fn sh_0_5() {
+        super::no_slip_ideal_row_at(0.5, 30);
+    }
+    #[test]
+    fn sh_0_6() {
+        super::no_slip_ideal_row_at(0.6, 30);
+    }
+}
+
+/// An ideal Domino T row of `n` blocks at spacing `sh`·h on a no-slip
+/// ground: the steady v̂_i over the tail within 1 % of the cooperative model,
+/// and no longer rising there (see above).
+fn no_slip_ideal_row_at(sh: f64, n: usize) {
+    let mut p = Preset::T.params().ideal();
     p.ground = Ground::NoSlip;
     let (h, d) = (p.block.height, p.block.thickness);
-    for (sh, n) in [
-        (0.1, 70),
-        (0.2, 50),
-        (0.3, 40),
-        (0.4, 30),
-        (0.5, 30),
-        (0.6, 30),
-    ] {
-        let row = RowSpec::new(p, sh * h, n, 1.0);
-        // The model against the theory: the freeze tolerance converged
-        // (10⁻⁴). The default 10⁻² freezes the far end of the slowly
-        // settling leaning train, which pushes the front a little less
-        // (−0.2 % at s/h 0.6; `default_freeze_is_within_half_a_percent`).
-        let converged = Settings {
-            freeze_tolerance: 1e-4,
-            ..Settings::default()
-        };
-        let r = run(&row, &converged).unwrap().report;
-        assert_eq!(r.hit_times.len(), n, "s/h {sh}: the wave reaches the end");
-        let tail = &r.speeds[n - 12..n - 2];
-        let steady = tail.iter().sum::<f64>() / tail.len() as f64;
-        let oracle = cooperative_speed(h, d, sh * h, 0.0);
-        let rising = tail[tail.len() - 1] - tail[0];
-        println!("s/h {sh}: steady {steady:.5}, cooperative {oracle:.5}, rise over the tail {rising:.1e}, v_na {:?}", r.natural_speed);
-        assert!(
-            rising.abs() < 2e-3 * oracle,
-            "s/h {sh}: v̂_i still changes by {rising} over the last blocks"
-        );
-        assert!(
-            (steady - oracle).abs() < 0.01 * oracle,
-            "s/h {sh}: steady {steady} vs cooperative {oracle}"
-        );
-    }
+    let row = RowSpec::new(p, sh * h, n, 1.0);
+    // The model against the theory: the freeze tolerance converged
+    // (10⁻⁴). The default 10⁻² freezes the far end of the slowly
+    // settling leaning train, which pushes the front a little less
+    // (−0.2 % at s/h 0.6; `default_freeze_is_within_half_a_percent`).
+    let converged = Settings {
+        freeze_tolerance: 1e-4,
+        ..Settings::default()
+    };
+    let r = run(&row, &converged).unwrap().report;
+    assert_eq!(r.hit_times.len(), n, "s/h {sh}: the wave reaches the end");
+    let tail = &r.speeds[n - 12..n - 2];
+    let steady = tail.iter().sum::<f64>() / tail.len() as f64;
+    let oracle = cooperative_speed(h, d, sh * h, 0.0);
+    let rising = tail[tail.len() - 1] - tail[0];
+    println!(
+        "s/h {sh}: steady {steady:.5}, cooperative {oracle:.5}, rise over the tail {rising:.1e}, v_na {:?}",
+        r.natural_speed
+    );
+    assert!(
+        rising.abs() < 2e-3 * oracle,
+        "s/h {sh}: v̂_i still changes by {rising} over the last blocks"
+    );
+    assert!(
+        (steady - oracle).abs() < 0.01 * oracle,
+        "s/h {sh}: steady {steady} vs cooperative {oracle}"
+    );
 }
 
 /// The defaults (adaptive impulse stepping at 10⁻⁴, freeze tolerance 10⁻²)
 /// against a converged run of the same model (the paper's fixed impulse step
 /// ΔP = 10⁻⁴ P₀, freeze tolerance 10⁻⁴) on ideal Domino T rows, Coulomb and
 /// no-slip ground: v̂_na within 0.5 %.
-#[test]
-fn default_freeze_is_within_half_a_percent() {
+///
+/// One test per ground and spacing, so that libtest runs them on all cores.
+mod default_freeze_is_within_half_a_percent {
+    use topple::domino::Ground;
+    #[test]
+    fn coulomb_sh_0_3() {
+        super::default_freeze_against_converged(Ground::Coulomb, 0.3);
+    }
+    #[test]
+    fn coulomb_sh_0_6() {
+        super::default_freeze_against_converged(Ground::Coulomb, 0.6);
+    }
+    #[test]
+    fn no_slip_sh_0_3() {
+        super::default_freeze_against_converged(Ground::NoSlip, 0.3);
+    }
+    #[test]
+    fn no_slip_sh_0_6() {
+        super::default_freeze_against_converged(Ground::NoSlip, 0.6);
+    }
+}
+
+/// v̂_na of a 30-block ideal Domino T row at spacing `sh`·h on `ground`: the
+/// defaults within 0.5 % of the converged run.
+fn default_freeze_against_converged(ground: Ground, sh: f64) {
     let converged = Settings {
         freeze_tolerance: 1e-4,
         ..Settings::paper_impacts()
     };
-    for ground in [Ground::Coulomb, Ground::NoSlip] {
-        let mut p = Preset::T.params().ideal();
-        p.ground = ground;
-        for sh in [0.3, 0.6] {
-            let row = RowSpec::new(p, sh * p.block.height, 30, 1.0);
-            let fast = run(&row, &Settings::default()).unwrap().report;
-            let reference = run(&row, &converged).unwrap().report;
-            let (a, b) = (
-                fast.natural_speed.unwrap(),
-                reference.natural_speed.unwrap(),
-            );
-            println!("{ground:?} s/h {sh}: default {a:.5}, converged {b:.5}");
-            assert!(
-                (a - b).abs() < 5e-3 * b,
-                "{ground:?} s/h {sh}: default {a} vs converged {b}"
-            );
-        }
-    }
+    let mut p = Preset::T.params().ideal();
+    p.ground = ground;
+    let row = RowSpec::new(p, sh * p.block.height, 30, 1.0);
+    let fast = run(&row, &Settings::default()).unwrap().report;
+    let reference = run(&row, &converged).unwrap().report;
+    let (a, b) = (
+        fast.natural_speed.unwrap(),
+        reference.natural_speed.unwrap(),
+    );
+    println!("{ground:?} s/h {sh}: default {a:.5}, converged {b:.5}");
+    assert!(
+        (a - b).abs() < 5e-3 * b,
+        "{ground:?} s/h {sh}: default {a} vs converged {b}"
+    );
 }

@@ -63,10 +63,10 @@ fn run_and_save(j: &Job, store: &RunStore) -> Result<ChainReport, String> {
     let report = run(&j.row, &j.settings)
         .map(|o| o.report)
         .map_err(|e| format!("{} {} x={}: {e}", figure_label(j.fig), j.key, j.x))?;
-    if !report.stopped_early {
-        if let Err(e) = store.save(&j.row, &j.settings, &report) {
-            eprintln!("warning: could not save a finished run: {e:#}");
-        }
+    if !report.stopped_early
+        && let Err(e) = store.save(&j.row, &j.settings, &report)
+    {
+        eprintln!("warning: could not save a finished run: {e:#}");
     }
     Ok(report)
 }
