@@ -44,10 +44,10 @@ pub(crate) fn check(
                 )));
             }
         }
-        if let [Some(a), Some(b)] = c.bodies {
-            if a == b {
-                return Err(bad(format!("joins body {a} to itself")));
-            }
+        if let [Some(a), Some(b)] = c.bodies
+            && a == b
+        {
+            return Err(bad(format!("joins body {a} to itself")));
         }
         let m = &c.material;
         if !(finite2(c.point)

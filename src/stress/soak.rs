@@ -89,10 +89,8 @@ pub fn soak(scene: &Scene, spec: &SoakSpec, memory: impl Fn() -> Option<u64> + S
         let mut reset = |frame: usize, _energy: f64| {
             let end = (frame + 1).is_multiple_of(per_cycle);
             if end {
-                if sample {
-                    if let Some(m) = memory() {
-                        samples.push(m);
-                    }
+                if sample && let Some(m) = memory() {
+                    samples.push(m);
                 }
                 cycles += 1;
             }

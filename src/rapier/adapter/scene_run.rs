@@ -198,15 +198,13 @@ pub fn run_scene(
         let reports = sw.step();
         let fallback = reports.iter().any(|r| r.resolution != Resolution::Lzb);
         impacts.extend(reports.iter().map(|&report| TimedImpact { time, report }));
-        if fallback {
-            if let Some(path) = dump.take() {
-                let json = serde_json::to_string_pretty(&impact_input_json(&sw))
-                    .expect("a JSON value always serialises");
-                std::fs::write(path, json).map_err(|source| SceneError::Io {
-                    path: path.clone(),
-                    source,
-                })?;
-            }
+        if fallback && let Some(path) = dump.take() {
+            let json = serde_json::to_string_pretty(&impact_input_json(&sw))
+                .expect("a JSON value always serialises");
+            std::fs::write(path, json).map_err(|source| SceneError::Io {
+                path: path.clone(),
+                source,
+            })?;
         }
         taken += 1;
         if let Some(row) = &sw.row {

@@ -69,10 +69,10 @@ impl Engine {
         // penetration covers every corner the row can drive into a neighbour.
         let lambda = self.rc.p.lambda_points;
         for i in self.lo.saturating_sub(1)..self.hi.min(self.row.n.saturating_sub(2)) {
-            if let Some(g) = rc.geom(&view, i, lambda + 2) {
-                if g.valid {
-                    deepest = deepest.min(g.gap);
-                }
+            if let Some(g) = rc.geom(&view, i, lambda + 2)
+                && g.valid
+            {
+                deepest = deepest.min(g.gap);
             }
         }
         self.max_penetration = self.max_penetration.max(-deepest);

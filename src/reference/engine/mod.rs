@@ -304,11 +304,11 @@ pub fn run_with_progress(
             stopped_early = true;
             break;
         }
-        if let Some(limit) = settings.wall_time_limit {
-            if start.elapsed().as_secs_f64() > limit {
-                stopped_early = true;
-                break;
-            }
+        if let Some(limit) = settings.wall_time_limit
+            && start.elapsed().as_secs_f64() > limit
+        {
+            stopped_early = true;
+            break;
         }
         e.advance(t_max)?;
         while hits_seen < row.n && e.hit[hits_seen].is_some() {

@@ -19,10 +19,11 @@ impl Engine {
                 continue;
             }
             for slot in [lambda + 1, lambda + 2] {
-                if let Some(g) = self.rc.geom(&view, i, slot) {
-                    if g.valid && g.gap <= self.eps_gap {
-                        found.push(i + 1);
-                    }
+                if let Some(g) = self.rc.geom(&view, i, slot)
+                    && g.valid
+                    && g.gap <= self.eps_gap
+                {
+                    found.push(i + 1);
                 }
             }
         }

@@ -15,10 +15,9 @@ impl ImpactPass {
                 .get(c)
                 .and_then(|co| co.parent())
                 .and_then(|h| world.bodies.get(h).map(|rb| (h, rb)))
+                && rb.is_dynamic()
             {
-                if rb.is_dynamic() {
-                    t0 = t0.max(self.motion.path(h, rb).t0);
-                }
+                t0 = t0.max(self.motion.path(h, rb).t0);
             }
         }
         t0
