@@ -77,9 +77,10 @@ pub struct SolverSpec {
     /// The paper's fixed impulse step ΔP/P₀ of the LZB resolver (10⁻⁴ in
     /// the paper), if set and `tolerance` is not.
     pub impulse_step: Option<f64>,
-    /// Adaptive impulse stepping at this relative tolerance; when neither
+    /// The time-domain resolver at this relative tolerance; when neither
     /// this nor `impulse_step` is set, the default of
-    /// [`crate::coupling::ToppleSettings`] (adaptive, 10⁻⁴).
+    /// [`crate::coupling::ToppleSettings`] (adaptive impulse stepping,
+    /// 10⁻⁴).
     pub tolerance: Option<f64>,
     /// λ points across a flat contact patch.
     pub lambda: usize,
