@@ -92,27 +92,44 @@ pub fn fig5_lines() -> Vec<TheoryLine> {
     ]
 }
 
-/// Whether a row's wave is no longer speeding up at the row's end: v̂_i of
-/// the last ten blocks before the last two (the end of the row slows its
-/// last blocks) rises by less than [`STEADY_RISE`] of their mean from the
-/// first of them to the last. A row too short to have twelve speeds does
-/// not count as steady.
+/// Whether a row's wave is no longer speeding up at the row's end. Over
+/// v̂_i of the last ten blocks before the last two (the end of the row
+/// slows its last blocks), the least-squares line through them rises by
+/// less than [`STEADY_RISE`] of their mean from the first block to the
+/// last, or its slope is within two standard errors of zero (the blocks of
+/// a chattering Table 1 row scatter by several per cent, which alone is no
+/// trend). A row too short to have twelve speeds does not count as steady.
 pub fn wave_is_steady(speeds: &[f64]) -> bool {
     let n = speeds.len();
     if n < 12 {
         return false;
     }
     let tail = &speeds[n - 12..n - 2];
-    let mean = tail.iter().sum::<f64>() / tail.len() as f64;
-    let rise = tail[tail.len() - 1] - tail[0];
-    mean.is_finite() && rise.is_finite() && rise < STEADY_RISE * mean
+    let k = tail.len() as f64;
+    let mean = tail.iter().sum::<f64>() / k;
+    let xm = (k - 1.0) / 2.0;
+    let sxx: f64 = (0..tail.len()).map(|i| (i as f64 - xm).powi(2)).sum();
+    let slope = tail
+        .iter()
+        .enumerate()
+        .map(|(i, y)| (i as f64 - xm) * (y - mean))
+        .sum::<f64>()
+        / sxx;
+    let residual: f64 = tail
+        .iter()
+        .enumerate()
+        .map(|(i, y)| (y - mean - slope * (i as f64 - xm)).powi(2))
+        .sum();
+    let standard_error = (residual / (k - 2.0) / sxx).sqrt();
+    if !(mean.is_finite() && slope.is_finite() && standard_error.is_finite()) {
+        return false;
+    }
+    slope * (k - 1.0) < STEADY_RISE * mean || slope <= 2.0 * standard_error
 }
 
 /// Largest relative rise of v̂_i over the tail of a steady wave
-/// ([`wave_is_steady`]): 1 %, about the scatter of v̂_i of a row whose wave
-/// is steady (ideal rows: 0.01–0.03 of v̂_na, docs/reference-performance.md)
-/// and well below the 15 % by which a wave still speeding up lags behind
-/// the cooperative model at s/h 0.1.
+/// ([`wave_is_steady`]): 1 %, well below the 15 % by which a wave still
+/// speeding up lags behind the cooperative model at s/h 0.1.
 pub const STEADY_RISE: f64 = 0.01;
 
 /// `fig5_ground`: the cooperative and extended (μ = [`GROUND_MU1`]) lines,
@@ -415,6 +432,11 @@ mod tests {
             *v -= 0.01 * (i - 28) as f64;
         }
         assert!(wave_is_steady(&slowing));
+        // a flat wave whose blocks scatter by ±4 %: no trend
+        let scattered: Vec<f64> = (0..40)
+            .map(|i| if i % 2 == 0 { 1.92 } else { 2.08 })
+            .collect();
+        assert!(wave_is_steady(&scattered));
         // too short to tell, or not finite
         assert!(!wave_is_steady(&[2.0; 11]));
         assert!(!wave_is_steady(&[f64::INFINITY; 20]));
