@@ -227,7 +227,7 @@ impl Engine {
             .solve_into(
                 &buf.bodies,
                 &buf.contacts,
-                &self.impact,
+                &self.s.impact,
                 &self.policy,
                 &mut buf.outcome,
             )
