@@ -112,7 +112,7 @@ impl ToppleSettings {
 impl Default for ToppleSettings {
     fn default() -> Self {
         ToppleSettings {
-            impact: ImpactSettings::adaptive_impulse(1e-4),
+            impact: ImpactSettings::adaptive(2e-7),
             patch: PatchRule::default(),
             min_approach_speed: 1e-3,
             max_group_hops: Some(Self::DEFAULT_WINDOW),

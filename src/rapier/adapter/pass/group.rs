@@ -196,14 +196,23 @@ impl ImpactPass {
             flat_tolerance: s.patch.flat_tolerance.max(closed_tolerance(s)),
             ..s.patch
         };
-        self.push_contacts(count, (pa, pb), bodies, material, &rule, persistent);
+        // the contact points are read off the smaller shape: a point on a
+        // wide ground carries the f32 rounding of the ground's own extent
+        // (6·10⁻⁵ of an ulp at 10³ units), which would shift a landing box's
+        // λ points off its centre and turn it
+        let first_smaller = ca.shape().compute_local_bounding_sphere().radius
+            <= cb.shape().compute_local_bounding_sphere().radius;
+        self.push_contacts(count, (pa, pb), bodies, material, &rule, persistent, first_smaller);
         true
     }
 
     /// Turns the points of the first `count` manifolds of a closed pair at
     /// poses `pa`, `pb` into contacts between `bodies`: the midpoint of each
     /// point pair, the normal of the first shape, λ points on a flat patch
-    /// ([`for_each_contact_point`]).
+    /// ([`for_each_contact_point`]). The midpoint is taken half the gap off
+    /// the point on the first shape if `first_smaller`, else on the second
+    /// (in exact arithmetic the same point).
+    #[allow(clippy::too_many_arguments)]
     fn push_contacts(
         &mut self,
         count: usize,
@@ -212,15 +221,23 @@ impl ImpactPass {
         material: ContactMaterial,
         rule: &PatchRule,
         persistent: bool,
+        first_smaller: bool,
     ) {
         for m in &self.manifolds[..count] {
             // points of a sub-shape are in its own frame
             let p1 = m.subshape_pos1().map_or(pa, |sub| pa * *sub);
             let p2 = m.subshape_pos2().map_or(pb, |sub| pb * *sub);
-            let normal = unit(v2(p1.transform_vector(m.local_n1).normalize()));
+            let n1 = p1.transform_vector(m.local_n1).normalize();
+            let normal = unit(v2(n1));
             self.points.clear();
             for p in &m.points {
-                let mid = 0.5 * (p1.transform_point(p.local_p1) + p2.transform_point(p.local_p2));
+                // local_n1 points from shape 1 to shape 2, dist > 0 a gap
+                let half = 0.5 * p.dist;
+                let mid = if first_smaller {
+                    p1.transform_point(p.local_p1) + n1 * half
+                } else {
+                    p2.transform_point(p.local_p2) - n1 * half
+                };
                 self.points.push(ManifoldPoint {
                     point: v2(mid),
                     dist: f64::from(p.dist),
