@@ -11,7 +11,8 @@
 //! ```text
 //! cargo bench --features bevy --bench bevy_frames
 //! cargo bench --features bevy --bench bevy_frames -- pyramid pile   # some scenes
-//! cargo bench --features bevy --bench bevy_frames -- --tolerance=1e-4 # time-domain resolver
+//! cargo bench --features bevy --bench bevy_frames -- --tolerance=1e-4 # time-domain resolver at 10⁻⁴
+//! cargo bench --features bevy --bench bevy_frames -- --impulse=1e-4   # adaptive impulse stepping
 //! ```
 //!
 //! Prints per scene and engine the mean and worst frame (whole `update()`)
@@ -108,11 +109,22 @@ fn budget() -> Option<u64> {
 }
 
 /// `--tolerance=TOL`: the time-domain resolver at this tolerance
-/// (`ImpactSettings::adaptive`) instead of topple's default impulse stepping.
+/// (`ImpactSettings::adaptive`) instead of topple's default (the same
+/// resolver at 2·10⁻⁷).
 fn tolerance() -> Option<f64> {
     std::env::args().find_map(|a| {
         a.strip_prefix("--tolerance=")
             .map(|v| v.parse().expect("--tolerance=TOL"))
+    })
+}
+
+/// `--impulse=TOL`: the adaptive impulse stepping at this tolerance
+/// (`ImpactSettings::adaptive_impulse`, the default before the time-domain
+/// resolver).
+fn impulse() -> Option<f64> {
+    std::env::args().find_map(|a| {
+        a.strip_prefix("--impulse=")
+            .map(|v| v.parse().expect("--impulse=TOL"))
     })
 }
 
@@ -122,6 +134,12 @@ fn with_budget(app: &mut App) {
             .resource_mut::<topple::bevy::ToppleConfig>()
             .settings
             .impact = topple::impact::ImpactSettings::adaptive(t);
+    }
+    if let Some(t) = impulse() {
+        app.world_mut()
+            .resource_mut::<topple::bevy::ToppleConfig>()
+            .settings
+            .impact = topple::impact::ImpactSettings::adaptive_impulse(t);
     }
     if let Some(w) = budget() {
         app.world_mut()

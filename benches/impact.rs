@@ -236,6 +236,9 @@ fn settings() -> Vec<(&'static str, ImpactSettings)> {
         max_steps: 1_000_000,
         ..s
     };
+    // the plugins' impact settings, which the label below names
+    let plugin_default = topple::coupling::ToppleSettings::default().impact;
+    assert_eq!(plugin_default, ImpactSettings::adaptive(2e-7));
     vec![
         (
             "paper: fixed ΔP = 10⁻⁴ P₀",
@@ -253,7 +256,7 @@ fn settings() -> Vec<(&'static str, ImpactSettings)> {
         // the plugins' rest speed at 1/60 s under 9.81 m/s²: 0.01 of the
         // impact threshold 2|g|Δt (docs/model.md §9)
         (
-            "adaptive impulse 10⁻⁴, rest speed 3.3·10⁻³ m/s (plugin default)",
+            "adaptive impulse 10⁻⁴, rest speed 3.3·10⁻³ m/s (plugin default before)",
             limited(ImpactSettings {
                 rest_speed: PLUGIN_REST_SPEED,
                 ..ImpactSettings::adaptive_impulse(1e-4)
@@ -264,6 +267,13 @@ fn settings() -> Vec<(&'static str, ImpactSettings)> {
             limited(ImpactSettings {
                 rest_speed: PLUGIN_REST_SPEED,
                 ..ImpactSettings::default()
+            }),
+        ),
+        (
+            "in time 2·10⁻⁷, rest speed 3.3·10⁻³ m/s (plugin default)",
+            limited(ImpactSettings {
+                rest_speed: PLUGIN_REST_SPEED,
+                ..plugin_default
             }),
         ),
     ]

@@ -7,23 +7,25 @@ use super::patch::PatchRule;
 
 /// Settings of the impact pass.
 ///
-/// The default resolves impacts with the resolver's adaptive stepping at a
-/// relative tolerance of 10⁻⁴ (on a wedged five-block domino group:
-/// velocities within 0.5 % of the paper's fixed step ΔP = 10⁻⁴ P₀ for the
-/// struck pair, in 240 steps against 4,880); set `impact` to
+/// The default resolves impacts with the time-domain resolver
+/// ([`ImpactSettings::adaptive`], docs/model.md §7) at a relative tolerance
+/// of 2·10⁻⁷: an elastic cradle keeps its energy to 10⁻⁶ in one step, and
+/// the domino rows at 1/60 s cost a quarter of what the adaptive impulse
+/// stepping cost (docs/game-rate.md); set `impact` to
 /// [`ImpactSettings::fixed`] for the paper's scheme.
 ///
 /// ```
 /// use topple::coupling::ToppleSettings;
+/// use topple::impact::ImpactSettings;
 /// let s = ToppleSettings::default();
 /// assert_eq!(s.patch.lambda, 9);
+/// assert_eq!(s.impact, ImpactSettings::adaptive(2e-7));
 /// ```
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct ToppleSettings {
-    /// Settings handed to the LZB resolver (default: adaptive impulse
-    /// stepping at 10⁻⁴; `ImpactSettings::adaptive(tol)` selects the
-    /// time-domain resolver, docs/model.md §7, which is 2–4 times cheaper on
-    /// the domino rows at 1/60 s but not yet on every scene).
+    /// Settings handed to the LZB resolver (default: the time-domain
+    /// resolver at 2·10⁻⁷; [`ImpactSettings::adaptive_impulse`] and
+    /// [`ImpactSettings::fixed`] give the impulse stepping).
     pub impact: ImpactSettings,
     /// Which manifold points are closed and how flat patches are subdivided.
     pub patch: PatchRule,

@@ -202,7 +202,15 @@ impl ImpactPass {
         // λ points off its centre and turn it
         let first_smaller = ca.shape().compute_local_bounding_sphere().radius
             <= cb.shape().compute_local_bounding_sphere().radius;
-        self.push_contacts(count, (pa, pb), bodies, material, &rule, persistent, first_smaller);
+        self.push_contacts(
+            count,
+            (pa, pb),
+            bodies,
+            material,
+            &rule,
+            persistent,
+            first_smaller,
+        );
         true
     }
 
