@@ -71,6 +71,16 @@ impl Integrator {
         self.patch_modes[p] == PatchMode::Idle && !self.patches[p].frictionless()
     }
 
+    /// Whether point `i`, touching with no compression (q = 0) at state
+    /// `y`, starts to load from rest: it approaches slower than the onset
+    /// speed and no friction patch waits for its load. Its force then grows
+    /// smoothly (q ∝ t², F ∝ t^(2α)), so its start needs no switch of its
+    /// own; e = 0 points pushed again after their compression ended start
+    /// this way, cycle after cycle.
+    pub(super) fn loads_from_rest(&self, i: usize, y: &[f64]) -> bool {
+        normal_rate(&self.rows[i], y) >= -self.scales.onset && !self.onset_matters(i)
+    }
+
     /// dy/dt at state `y` into `dy`. With `probe`, notes the points and
     /// patches whose mode's condition fails at `y` (see events.rs).
     pub(super) fn eval(&mut self, y: &[f64], dy: &mut [f64], probe: bool) {

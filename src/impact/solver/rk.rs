@@ -209,8 +209,11 @@ impl Integrator {
         rk.dense_ready = false;
         let x0 = self.clock.x;
         let lay = self.layout;
-        for (i, point) in self.points.iter_mut().enumerate() {
-            point.open = point.mode == PointMode::Compress && rk.y0[lay.q(i)] <= 0.0;
+        for i in 0..self.points.len() {
+            let q0 = rk.y0[lay.q(i)];
+            let open = self.points[i].mode == PointMode::Compress
+                && (q0 < 0.0 || (q0 == 0.0 && !self.loads_from_rest(i, &rk.y0)));
+            self.points[i].open = open;
         }
         if !rk.fresh {
             let (y0, k) = (&rk.y0, &mut rk.k[0]);
