@@ -249,7 +249,7 @@ impl Engine {
             .solve_into(
                 &buf.bodies,
                 &buf.contacts,
-                &self.s.impact,
+                &self.impact,
                 &self.policy,
                 &mut buf.outcome,
             )

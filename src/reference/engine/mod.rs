@@ -32,7 +32,7 @@ use super::snapshot::Snapshot;
 use super::stepper::Stages;
 use crate::coupling::{FallbackPolicy, GroupSolver};
 use crate::domino::{BlockSeries, ChainReport, EnergyReport, RowSpec};
-use crate::impact::{Body, Contact, ImpactOutcome};
+use crate::impact::{Body, Contact, ImpactOutcome, ImpactSettings};
 
 mod active;
 mod events;
@@ -205,6 +205,9 @@ struct Engine {
     impacts_at_this_instant: usize,
     // --- impacts (`impacts.rs`)
     solver: GroupSolver,
+    /// The resolver's settings: `Settings::impact` with its rest speed
+    /// raised to the approach that starts an impact (`v_app`).
+    impact: ImpactSettings,
     policy: FallbackPolicy,
     impact_buffers: ImpactBuffers,
     // --- broad phase of the far pairs (`window.rs`)
@@ -264,6 +267,7 @@ impl Engine {
             dynamics: Dynamics::default(),
             stages: Stages::default(),
             solver: GroupSolver::default(),
+            impact: impact_settings(settings, vbar),
             policy: impact_policy(settings),
             impact_buffers: ImpactBuffers::default(),
             hit: vec![None; n],
@@ -308,6 +312,21 @@ impl Engine {
         e.sync_in();
         e.energy.initial = e.total_energy();
         Ok(e)
+    }
+}
+
+/// The resolver's settings for the row: `Settings::impact` with its rest
+/// speed (m/s) raised to the engine's own impact threshold
+/// `approach_tolerance · √(gh)` (`vbar`, m/s): a contact approaching slower
+/// than that does not start an impact, so an impact ends once nothing
+/// approaches faster (docs/model.md §9). Without it, two blocks wedged
+/// between opposite faces (a Table 1 T row at s/h 0.5) bounced between
+/// those faces in ever shorter cycles (e = 0.62) until the step limit, and
+/// the impact ended plastic.
+fn impact_settings(settings: &Settings, vbar: f64) -> ImpactSettings {
+    ImpactSettings {
+        rest_speed: settings.impact.rest_speed.max(settings.approach_tolerance * vbar),
+        ..settings.impact
     }
 }
 
