@@ -229,28 +229,24 @@ impl Dynamics {
     /// band (rhs untouched except resized) and returns false if nothing to do.
     fn assemble(&mut self, rc: &RowConst) {
         let m = self.unknowns.len();
-        // The unknowns come sorted by block, so the first block of their
-        // spans rises along the list, except where a contact between blocks
-        // that are not neighbours has a frozen block first (its span starts
-        // at the moving one); then every pair is looked at.
-        let sorted = self
+        // The unknowns come sorted by the first block of their spans: every
+        // contact is between moving blocks (a contact with a frozen block is
+        // never active) and listed under its lower block, also between
+        // blocks that are not neighbours. So the scan of each row can stop
+        // at the first unknown beyond its span.
+        debug_assert!(self
             .unknowns
             .windows(2)
-            .all(|w| span(&w[0]).0 <= span(&w[1]).0);
+            .all(|w| span(&w[0]).0 <= span(&w[1]).0));
         let mut bw = 0;
         for r in 0..m {
-            let (lr, hr) = span(&self.unknowns[r]);
+            let (_, hr) = span(&self.unknowns[r]);
             for s in r + 1..m {
-                let (ls, hs) = span(&self.unknowns[s]);
+                let (ls, _) = span(&self.unknowns[s]);
                 if ls > hr {
-                    if sorted {
-                        break;
-                    }
-                    continue;
+                    break;
                 }
-                if sorted || hs >= lr {
-                    bw = bw.max(s - r);
-                }
+                bw = bw.max(s - r);
             }
         }
         let rhs = std::mem::take(&mut self.band.rhs);

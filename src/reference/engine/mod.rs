@@ -154,12 +154,13 @@ impl ActiveSlots {
 /// touch one whose extent along x overlaps its own.
 #[derive(Debug, Default)]
 struct Reach {
-    /// Running maximum over the frozen blocks 0..=k behind the window of
-    /// the right end of their x extents (m), for k < lo: the frozen blocks
-    /// a moving one can reach back to.
-    behind: Vec<f64>,
-    /// Scratch of `for_each_slot`: per block from its first one, the x
-    /// extent (left, right) and the least left end from that block on (m).
+    /// The frozen blocks k < lo behind the window: the x extent (left,
+    /// right) of each and the running maximum of the right ends over
+    /// 0..=k (m), which says how far back a moving block can reach.
+    behind: Vec<[f64; 3]>,
+    /// Scratch of `for_each_slot`: per block from lo on (the window and
+    /// the untouched blocks ahead it can reach), the x extent (left,
+    /// right) and the least left end from that block on (m).
     extents: RefCell<Vec<[f64; 3]>>,
 }
 

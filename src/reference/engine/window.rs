@@ -97,7 +97,7 @@ impl Engine {
         let mut extents = self.reach.extents.borrow_mut();
         let from = self.x_extents(view, 2.0 * margin, &mut extents);
         for i in from..first {
-            self.far_pairs(view, i, from, &extents, margin, &mut f);
+            self.far_pairs(view, i, &extents, margin, &mut f);
         }
         for i in first..self.hi.min(n) {
             if i >= self.lo {
@@ -129,30 +129,28 @@ impl Engine {
                     f(i, pair_slot(k, lambda));
                 }
             });
-            self.far_pairs(view, i, from, &extents, margin, &mut f);
+            if i >= from {
+                self.far_pairs(view, i, &extents, margin, &mut f);
+            }
         }
     }
 
-    /// The broad phase of the far pairs: into `extents`, from the block it
-    /// returns on, the x extent of every block a moving block can reach
-    /// within `margin` (m) — the frozen blocks behind the window whose
-    /// extent reaches the window's left end (`Reach::behind`), the window,
-    /// and the untouched blocks ahead up to the first one beyond the
-    /// window's right end (they stand where the row put them, in order) —
-    /// each with the least left end from it on.
+    /// The broad phase of the far pairs: into `extents`, the x extent of
+    /// every block from lo on that a moving block can reach within
+    /// `margin` (m) — the window, and the untouched blocks ahead up to the
+    /// first one beyond the window's right end (they stand where the row
+    /// put them, in order) — each with the least left end from it on.
+    /// Returns the first frozen block behind the window whose extent
+    /// reaches the window's left end (`Reach::behind`).
     fn x_extents(&self, view: &View, margin: f64, extents: &mut Vec<[f64; 3]>) -> usize {
         let block = &self.rc.p.block;
         let (lo, hi) = (self.lo, self.hi);
         let (mut left, mut right) = (f64::INFINITY, f64::NEG_INFINITY);
+        extents.clear();
         for i in lo..hi {
             let (a, b) = x_extent(block, view.q(i));
             left = left.min(a);
             right = right.max(b);
-        }
-        let from = self.reach.behind.partition_point(|&r| r < left - margin);
-        extents.clear();
-        for i in from..hi {
-            let (a, b) = x_extent(block, view.q(i));
             extents.push([a, b, 0.0]);
         }
         for j in hi..self.row.n {
@@ -167,7 +165,7 @@ impl Engine {
             least = least.min(e[0]);
             e[2] = least;
         }
-        from
+        self.reach.behind.partition_point(|e| e[2] < left - margin)
     }
 
     /// The contacts between block `i` and the blocks j ≥ i + 2 whose x
@@ -175,27 +173,30 @@ impl Engine {
     /// two moving, that pass the separating-axis test and have a corner
     /// within `margin` of the other ([`near_pair_contacts`]), given to `f`
     /// as far slots of block i. `extents` as [`Engine::x_extents`] made
-    /// them, from block `from` on. The scan along the row stops at the
-    /// first block from which every left end lies beyond block i's reach.
+    /// them (from block lo on); a frozen block i < lo takes its extent from
+    /// `Reach::behind` and meets only the blocks from lo on. The scan along
+    /// the row stops at the first block from which every left end lies
+    /// beyond block i's reach.
     fn far_pairs(
         &self,
         view: &View,
         i: usize,
-        from: usize,
         extents: &[[f64; 3]],
         margin: f64,
         f: &mut impl FnMut(usize, usize),
     ) {
         let block = &self.rc.p.block;
         let lambda = self.rc.p.lambda_points;
-        let moving = |j: usize| j >= self.lo && j < self.hi;
+        let lo = self.lo;
+        let moving = |j: usize| j >= lo && j < self.hi;
         let grown = 2.0 * margin;
-        // a frozen block left out of the extents reaches no moving block
-        let Some(&[left, right, _]) = i.checked_sub(from).and_then(|k| extents.get(k)) else {
-            return;
+        let [left, right, _] = if i < lo {
+            self.reach.behind[i]
+        } else {
+            extents[i - lo]
         };
-        for j in i + 2..from + extents.len() {
-            let [a, b, least] = extents[j - from];
+        for j in (i + 2).max(lo)..lo + extents.len() {
+            let [a, b, least] = extents[j - lo];
             if least > right + grown {
                 break;
             }
@@ -252,15 +253,15 @@ impl Engine {
                 self.new_active.push(*a);
             }
         }
-        // the frozen blocks behind the window: the running maximum of the
-        // right ends of their x extents (`Reach::behind`)
+        // the frozen blocks behind the window: their x extents and the
+        // running maximum of the right ends (`Reach::behind`)
         let block = &self.rc.p.block;
         let behind = &mut self.reach.behind;
         behind.truncate(lo);
         while behind.len() < lo {
-            let (_, right) = x_extent(block, self.pos[behind.len()]);
-            let before = behind.last().copied().unwrap_or(f64::NEG_INFINITY);
-            behind.push(before.max(right));
+            let (left, right) = x_extent(block, self.pos[behind.len()]);
+            let before = behind.last().map_or(f64::NEG_INFINITY, |e| e[2]);
+            behind.push([left, right, before.max(right)]);
         }
         self.set_active();
         self.sync_in();
