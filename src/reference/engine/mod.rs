@@ -326,7 +326,10 @@ impl Engine {
 /// the impact ended plastic.
 fn impact_settings(settings: &Settings, vbar: f64) -> ImpactSettings {
     ImpactSettings {
-        rest_speed: settings.impact.rest_speed.max(settings.approach_tolerance * vbar),
+        rest_speed: settings
+            .impact
+            .rest_speed
+            .max(settings.approach_tolerance * vbar),
         ..settings.impact
     }
 }
