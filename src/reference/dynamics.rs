@@ -5,7 +5,8 @@
 //! and the projections that keep persistent contacts exactly closed.
 //!
 //! Units: SI (m, s, kg, N). The Delassus matrix W M⁻¹ W is banded (a contact
-//! couples two neighbouring blocks) and solved by [`Band`] in O(contacts).
+//! couples two neighbouring blocks, rarely two a few places apart) and solved
+//! by [`Band`] in O(contacts).
 
 use super::band::Band;
 use super::geometry::{geom, kin, Geom, Kin, Surface};
@@ -228,6 +229,15 @@ impl Dynamics {
     /// band (rhs untouched except resized) and returns false if nothing to do.
     fn assemble(&mut self, rc: &RowConst) {
         let m = self.unknowns.len();
+        // The unknowns come sorted by the first block of their spans: every
+        // contact is between moving blocks (a contact with a frozen block is
+        // never active) and listed under its lower block, also between
+        // blocks that are not neighbours. So the scan of each row can stop
+        // at the first unknown beyond its span.
+        debug_assert!(self
+            .unknowns
+            .windows(2)
+            .all(|w| span(&w[0]).0 <= span(&w[1]).0));
         let mut bw = 0;
         for r in 0..m {
             let (_, hr) = span(&self.unknowns[r]);

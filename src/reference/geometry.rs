@@ -98,8 +98,31 @@ const fn pair_table() -> [(Side, Corner, Face); 32] {
 /// | λ+2 | [`PAIR_SLOTS`]\[1\]: the heel of block i+1 on the front face of block i (the engine uses it for the last pair, or everywhere with `heel_contacts`) |
 /// | λ+3 | the back top corner on the ground (a block lying on its back) |
 /// | λ+4 … λ+33 | [`PAIR_SLOTS`]\[2…31\]: every other corner of blocks i and i+1 on every face of the other |
+///
+/// Beyond these, the slots of block i from `slots_per_block(λ)` on hold the
+/// pairs with blocks that are not its neighbour ([`far_slot`]): pair k of
+/// [`PAIR_SLOTS`] between block i and block i + d, d ≥ 2, with `Behind`
+/// meaning block i's corner on block i + d's face.
 pub(crate) fn slots_per_block(lambda: usize) -> usize {
     lambda + 4 + PAIR_SLOTS.len() - 2
+}
+
+/// The slot of block i that holds pair contact `k` of [`PAIR_SLOTS`]
+/// between block i and block i + `offset`, `offset` ≥ 2 (blocks that are
+/// not neighbours: a block lying flat, sliding back or rebounding can reach
+/// one several places away).
+#[inline]
+pub(crate) fn far_slot(offset: usize, k: usize, lambda: usize) -> usize {
+    debug_assert!(offset >= 2 && k < PAIR_SLOTS.len());
+    slots_per_block(lambda) + (offset - 2) * PAIR_SLOTS.len() + k
+}
+
+/// The block that holds the face or corner facing block `i` in pair slot
+/// `slot` of block i (i + 1 for a neighbour's slot, i + d for a far slot);
+/// `None` for a ground slot.
+#[inline]
+pub(crate) fn partner(i: usize, slot: usize, lambda: usize) -> Option<usize> {
+    pair_of(slot, lambda).map(|(offset, _)| i + offset)
 }
 
 /// The slot of block i that holds pair contact `k` of [`PAIR_SLOTS`].
@@ -112,13 +135,19 @@ pub(crate) fn pair_slot(k: usize, lambda: usize) -> usize {
     }
 }
 
-/// The pair contact (index into [`PAIR_SLOTS`]) a slot holds, if it is one.
+/// The pair contact a slot holds, if it is one: the offset d of the other
+/// block (1 for the neighbour, ≥ 2 for a far slot) and the index into
+/// [`PAIR_SLOTS`].
 #[inline]
-pub(crate) fn pair_of(slot: usize, lambda: usize) -> Option<usize> {
+pub(crate) fn pair_of(slot: usize, lambda: usize) -> Option<(usize, usize)> {
+    let near = slots_per_block(lambda);
     if slot == lambda + 1 || slot == lambda + 2 {
-        Some(slot - lambda - 1)
+        Some((1, slot - lambda - 1))
+    } else if slot >= near {
+        let far = slot - near;
+        Some((2 + far / PAIR_SLOTS.len(), far % PAIR_SLOTS.len()))
     } else if slot >= lambda + 4 {
-        Some(slot - lambda - 2)
+        Some((1, slot - lambda - 2))
     } else {
         None
     }
@@ -282,7 +311,7 @@ pub(crate) fn geom(
     slot: usize,
     q: impl Fn(usize) -> [f64; 3],
 ) -> Option<Geom> {
-    let Some(k) = pair_of(slot, lambda) else {
+    let Some((offset, k)) = pair_of(slot, lambda) else {
         let local = if slot < lambda {
             block.bottom_point(slot, lambda)
         } else if slot == lambda {
@@ -300,13 +329,14 @@ pub(crate) fn geom(
             valid: true,
         });
     };
-    if i + 1 >= n {
+    let j = i + offset;
+    if j >= n {
         return None;
     }
     let (side, corner, face) = PAIR_SLOTS[k];
     let (cb, fb) = match side {
-        Side::Behind => (i, i + 1),
-        Side::Ahead => (i + 1, i),
+        Side::Behind => (i, j),
+        Side::Ahead => (j, i),
     };
     let p = world_point(q(cb), corner_local(block, corner));
     let qf = q(fb);
@@ -364,7 +394,7 @@ pub(crate) fn kin(g: &Geom, q: impl Fn(usize) -> [f64; 3], v: impl Fn(usize) -> 
     }
 }
 
-/// The pair contacts k ≥ 2 of [`PAIR_SLOTS`] between blocks i and i+1 (at
+/// The pair contacts k of [`PAIR_SLOTS`] between blocks i and j > i (at
 /// `qi`, `qj`) that can be within `margin` (m) of closing, given to `f`: each
 /// corner of either block taken into the other's frame, and, if it lies
 /// within `margin` of that block's outline, its contact with the nearest
@@ -404,15 +434,46 @@ pub(crate) fn near_pair_contacts(
                 (false, _, true) => Face::Bottom,
                 (false, _, false) => Face::Top,
             };
-            if let Some(k) = PAIR_SLOTS
-                .iter()
-                .skip(2)
-                .position(|e| *e == (side, corner, face))
-            {
-                f(k + 2);
+            if let Some(k) = PAIR_SLOTS.iter().position(|e| *e == (side, corner, face)) {
+                f(k);
             }
         }
     }
+}
+
+/// The extent along x (m) of a block at `q`: its centre's x ∓ the half
+/// width of its outline's projection, d/2 |cos φ| + h/2 |sin φ|.
+#[inline]
+pub(crate) fn x_extent(block: &Block, q: [f64; 3]) -> (f64, f64) {
+    let (s, c) = turn(q[2]);
+    let half = 0.5 * (block.thickness * c.abs() + block.height * s.abs());
+    (q[0] - half, q[0] + half)
+}
+
+/// Whether two blocks at `qa`, `qb` can be within `margin` (m) of touching:
+/// no face normal of either block separates their outlines by more than
+/// `margin` (the separating-axis test, exact for two rectangles). The
+/// outline of a block grown by `margin` reaches at most √2 `margin` further
+/// along any axis, so a pair with a corner within `margin` of the other's
+/// outline ([`near_pair_contacts`]) passes with `2 margin`.
+#[inline]
+pub(crate) fn outlines_within(block: &Block, qa: [f64; 3], qb: [f64; 3], margin: f64) -> bool {
+    let (hd, hh) = (0.5 * block.thickness, 0.5 * block.height);
+    let (sa, ca) = turn(qa[2]);
+    let (sb, cb) = turn(qb[2]);
+    // the relative angle: cos, sin of φb − φa
+    let (c, s) = ((ca * cb + sa * sb).abs(), (sb * ca - sa * cb).abs());
+    // the other block's half extent along one's own x and y axes
+    let along_x = hd * c + hh * s;
+    let along_y = hd * s + hh * c;
+    let r = [qb[0] - qa[0], qb[1] - qa[1]];
+    // the centre offset in a's frame, then in b's
+    let (ua, va) = (ca * r[0] + sa * r[1], -sa * r[0] + ca * r[1]);
+    let (ub, vb) = (cb * r[0] + sb * r[1], -sb * r[0] + cb * r[1]);
+    ua.abs() <= hd + along_x + margin
+        && va.abs() <= hh + along_y + margin
+        && ub.abs() <= hd + along_x + margin
+        && vb.abs() <= hh + along_y + margin
 }
 
 #[cfg(test)]
@@ -509,8 +570,9 @@ mod tests {
     /// search over random configurations: [`geom`] finds a corner on a face
     /// exactly when the corner, taken into the face block's frame, projects
     /// onto that face from outside or is inside with that face the nearest;
-    /// and [`near_pair_contacts`] hands on every contact k ≥ 2 within its
-    /// margin that [`geom`] finds valid.
+    /// and [`near_pair_contacts`] hands on every contact within its margin
+    /// that [`geom`] finds valid, whose two blocks [`outlines_within`]
+    /// passes.
     #[test]
     fn pair_contacts_match_a_brute_force_search() {
         let block = Block::new(0.08, 0.012);
@@ -569,7 +631,8 @@ mod tests {
                 if g.valid {
                     seen_valid += 1;
                 }
-                if k >= 2 && g.valid && g.gap <= 0.5 * margin && !tie {
+                if g.valid && g.gap <= 0.5 * margin && !tie {
+                    assert!(outlines_within(&block, qi, qj, 2.0 * margin));
                     assert!(
                         near.contains(&k),
                         "k {k} valid at gap {} not handed on",
@@ -579,5 +642,116 @@ mod tests {
             }
         }
         assert!(seen_valid > 1000, "{seen_valid}");
+    }
+
+    /// A far slot (block i against block i + d) is the neighbour's pair
+    /// slot with block i + d put where block i + 1 was: the same gap,
+    /// point, normal and validity, and the same velocity terms; and
+    /// [`pair_of`] and [`partner`] give back what [`far_slot`] encoded.
+    #[test]
+    fn far_slots_are_the_neighbour_pair_moved() {
+        let block = Block::new(0.08, 0.0096);
+        let lambda = 9;
+        let near_q = [[0.003, 0.039, -0.6], [0.0262, 0.0395, -0.15]];
+        let v = [[0.2, -0.1, -3.0], [0.05, 0.02, -1.3]];
+        for d in 2..5 {
+            let n = d + 1;
+            let far_q = |j: usize| {
+                if j == 0 {
+                    near_q[0]
+                } else if j == d {
+                    near_q[1]
+                } else {
+                    [1.0 + j as f64, 0.04, 0.0]
+                }
+            };
+            let far_v = |j: usize| if j == d { v[1] } else { v[0] };
+            for k in 0..PAIR_SLOTS.len() {
+                let slot = far_slot(d, k, lambda);
+                assert_eq!(pair_of(slot, lambda), Some((d, k)));
+                assert_eq!(partner(0, slot, lambda), Some(d));
+                let g = geom(&block, lambda, n, 0, slot, far_q).unwrap();
+                let gn = geom(&block, lambda, 2, 0, pair_slot(k, lambda), |j| near_q[j]).unwrap();
+                assert_eq!(g.gap, gn.gap);
+                assert_eq!(g.point, gn.point);
+                assert_eq!(g.normal, gn.normal);
+                assert_eq!(g.valid, gn.valid);
+                let to_near = |j: usize| if j == d { 1 } else { j };
+                assert_eq!(to_near(g.corner), gn.corner);
+                assert_eq!(g.face.map(to_near), gn.face);
+                let k1 = kin(&g, far_q, far_v);
+                let k2 = kin(&gn, |j| near_q[j], |j| v[j]);
+                assert_eq!(
+                    (k1.gdot, k1.vt, k1.sn, k1.st),
+                    (k2.gdot, k2.vt, k2.sn, k2.st)
+                );
+                // the slot does not exist for a row too short
+                assert!(geom(&block, lambda, d, 0, slot, far_q).is_none());
+            }
+        }
+        for k in 0..PAIR_SLOTS.len() {
+            assert_eq!(pair_of(pair_slot(k, lambda), lambda), Some((1, k)));
+        }
+        assert_eq!(pair_of(back_top_slot(lambda), lambda), None);
+    }
+
+    /// [`x_extent`] is the range of the four corners' x, and
+    /// [`outlines_within`] passes every pair of blocks with a corner of one
+    /// inside the other, checked on random poses.
+    #[test]
+    fn extents_and_the_separating_axis_test_against_the_corners() {
+        let block = Block::new(0.08, 0.012);
+        let (hd, hh) = (0.006, 0.04);
+        let mut seed = 0x9e37_79b9_7f4a_7c15u64;
+        let mut unit = move || {
+            seed ^= seed << 13;
+            seed ^= seed >> 7;
+            seed ^= seed << 17;
+            (seed >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let corners = |q: [f64; 3]| CORNERS.map(|c| world_point(q, corner_local(&block, c)));
+        let inside = |p: [f64; 2], q: [f64; 3]| {
+            let (s, c) = q[2].sin_cos();
+            let r = [p[0] - q[0], p[1] - q[1]];
+            let (u, v) = (c * r[0] + s * r[1], -s * r[0] + c * r[1]);
+            u.abs() < hd && v.abs() < hh
+        };
+        let (mut overlapping, mut apart) = (0, 0);
+        for _ in 0..20_000 {
+            let qa = [0.0, 0.04, (unit() - 0.5) * 7.0];
+            let qb = [
+                (unit() - 0.5) * 0.2,
+                0.04 + (unit() - 0.5) * 0.2,
+                (unit() - 0.5) * 7.0,
+            ];
+            let (lo, hi) = x_extent(&block, qa);
+            let xs = corners(qa).map(|p| p[0]);
+            let (min, max) = xs
+                .iter()
+                .fold((f64::MAX, f64::MIN), |(a, b), x| (a.min(*x), b.max(*x)));
+            assert!((lo - min).abs() < 1e-15 && (hi - max).abs() < 1e-15);
+            let touch = corners(qa).iter().any(|p| inside(*p, qb))
+                || corners(qb).iter().any(|p| inside(*p, qa));
+            let within = outlines_within(&block, qa, qb, 0.0);
+            if touch {
+                assert!(within, "{qa:?} {qb:?}");
+                overlapping += 1;
+            }
+            if !within {
+                apart += 1;
+                // separated: no point of a's outline (sampled along its
+                // edges) lies inside b
+                let c = corners(qa);
+                for e in 0..4 {
+                    let (p, q) = (c[e], c[(e + 1) % 4]);
+                    for t in 0..=40 {
+                        let t = t as f64 / 40.0;
+                        let x = [p[0] + t * (q[0] - p[0]), p[1] + t * (q[1] - p[1])];
+                        assert!(!inside(x, qb), "{qa:?} {qb:?}");
+                    }
+                }
+            }
+        }
+        assert!(overlapping > 1000 && apart > 1000, "{overlapping} {apart}");
     }
 }

@@ -50,7 +50,7 @@ mod settings;
 mod snapshot;
 mod stepper;
 
-pub use engine::{run, run_with_progress, EngineError, RunResult};
+pub use engine::{run, run_from, run_with_progress, EngineError, RunResult};
 pub use settings::{Integrator, Settings};
 #[cfg(feature = "plots")]
 pub use snapshot::snapshot_png;

@@ -6,7 +6,7 @@
 //! measure (`max_penetration`, every corner against every neighbouring face).
 
 use topple::domino::{ChainReport, Preset, RowSpec};
-use topple::reference::{run, Settings};
+use topple::reference::{run, run_from, Settings};
 use topple::stress::{draw, run_combo, violations, RowWatch, StressEngine, SweepSpec};
 
 #[test]
@@ -242,4 +242,139 @@ fn a_step_bound_stops_a_run_where_it_says() {
     assert_eq!(bounded.steps, 300);
     assert!(bounded.report.stopped_early);
     assert!(bounded.report.hit_times.len() < row.n);
+}
+
+/// Combo 2555 of the full sweep's seed 3 (Domino X, s/h 0.113, e1 0.85,
+/// Δt 0.1 ms, 13 blocks; the wave stops at block 6): block 4, standing
+/// again after rocking for 3 s, slid forward on its feet from t = 3.56 s,
+/// faster and faster, through block 5 and 0.18 h into block 6. Its ground
+/// contacts kept sliding friction along a slip that had reversed a little
+/// in each step, each step's event reference being its own start, so that
+/// the slip-reversal event never fired and friction drove the block on.
+/// Now a condition met where the mode was chosen and violated since is an
+/// event. The row must pass every check of the sweep (its overlap watch is
+/// independent of the engine's contacts).
+#[test]
+fn combo_2555_of_the_third_full_sweep_runs_clean() {
+    let spec = SweepSpec::full(3);
+    let c = draw(3, 2555, spec.n_lo, spec.n_hi);
+    assert_eq!(c.engine, StressEngine::Reference);
+    let o = run_combo(&c, 120.0);
+    let v = violations(&c, &o);
+    println!(
+        "combo 2555: {} hits of {}, overlap {:.3e} h, {:.1} s",
+        o.hits, c.row.n, o.penetration, o.wall
+    );
+    assert!(v.is_empty(), "{v:?}");
+    assert!(o.hits >= 3, "{} hits", o.hits);
+    assert!(o.penetration < 0.01);
+}
+
+/// A block lying on its face, a block standing 5 h away, and a block lying
+/// on its face 0.05 h above the first, shifted by h/4 along it: the third
+/// block falls onto the first, which is not its neighbour, and comes to
+/// rest on it. The only contact between blocks is that pair
+/// (`geometry::far_slot`). Returns (time, poses) every millisecond.
+fn plank_on_a_non_neighbour(plank: usize, far: usize) -> (Looks, topple::domino::ChainReport) {
+    use std::f64::consts::FRAC_PI_2;
+    let p = Preset::T.params();
+    let (h, d) = (p.block.height, p.block.thickness);
+    let row = RowSpec::new(p, 0.5 * h, 3, 1.0);
+    let mut poses = [[0.0; 3]; 3];
+    poses[0] = [0.0, 0.5 * d, -FRAC_PI_2];
+    poses[far] = [5.0 * h, 0.5 * h, 0.0];
+    poses[plank] = [0.25 * h, 1.5 * d + 0.05 * h, -FRAC_PI_2];
+    let t_end = 0.4;
+    let settings = Settings {
+        t_max: Some(t_end),
+        snapshot_times: (0..400).map(|k| k as f64 * 1e-3).collect(),
+        ..Settings::default()
+    };
+    let out = run_from(&row, &settings, &poses, &[[0.0; 3]; 3]).unwrap();
+    let looks = out
+        .snapshots
+        .into_iter()
+        .map(|s| (s.time, s.blocks))
+        .collect();
+    (looks, out.report)
+}
+
+/// The configuration of [`plank_on_a_non_neighbour`], checked against what
+/// does not depend on the engine's contacts: the sweep's overlap watch
+/// (every corner of every block against every face of every other block),
+/// the rest state in closed form (the plank's centre 1.5 d above the
+/// ground, lying flat, the first block unmoved, the far block untouched),
+/// no energy created (the final K + U not above the initial), and the same
+/// fall with the plank as the first block's neighbour (the pair contacts
+/// the engine had before): the same landing and the same rest.
+#[test]
+fn a_block_falling_onto_a_non_neighbour_rests_on_it() {
+    let p = Preset::T.params();
+    let (h, d) = (p.block.height, p.block.thickness);
+    let (looks, report) = plank_on_a_non_neighbour(2, 1);
+    let mut watch = RowWatch::new(h, d);
+    for (t, q) in &looks {
+        watch.look(*t, q);
+    }
+    println!(
+        "deepest overlap {:.3e} h ({}), {} impacts",
+        watch.seen.penetration, watch.seen.penetration_at, report.impacts
+    );
+    // the engine's gap tolerance is 1e-6 h; the sweep's limit 0.01 h
+    assert!(
+        watch.seen.penetration < 1e-4,
+        "{}",
+        watch.seen.penetration_at
+    );
+    assert!(report.impacts >= 1, "the plank never landed");
+    let (_, last) = looks.last().unwrap();
+    let [x2, y2, phi2] = last[2];
+    assert!((y2 - 1.5 * d).abs() < 1e-4 * h, "plank at y = {y2} m");
+    assert!(
+        (phi2.abs() - std::f64::consts::FRAC_PI_2).abs() < 1e-4,
+        "{phi2}"
+    );
+    assert!((x2 - 0.25 * h).abs() < 0.05 * h, "plank at x = {x2} m");
+    assert!((last[0][1] - 0.5 * d).abs() < 1e-4 * h);
+    let far = [5.0 * h, 0.5 * h, 0.0];
+    assert!(
+        (0..3).all(|k| (last[1][k] - far[k]).abs() < 1e-9 * h),
+        "{:?}",
+        last[1]
+    );
+    // energy: nothing created, and what is left is the rest state's
+    // potential energy (m g y summed)
+    let e = report.energy.unwrap();
+    let g = p.gravity;
+    let m = p.block.mass;
+    let rest = m * g * (0.5 * d + 0.5 * h + 1.5 * d);
+    assert!(
+        e.kinetic + e.potential <= e.initial * (1.0 + 1e-12),
+        "{e:?}"
+    );
+    assert!(
+        (e.potential - rest).abs() < 1e-4 * m * g * h,
+        "{} vs {rest}",
+        e.potential
+    );
+    assert!(e.kinetic < 1e-6 * m * g * h, "{e:?}");
+    // the same fall between neighbours
+    let (near, _) = plank_on_a_non_neighbour(1, 2);
+    let landing = |looks: &Looks, plank: usize| {
+        looks
+            .iter()
+            .find(|(_, q)| q[plank][1] < 1.5 * d + 1e-3 * h)
+            .map(|(t, _)| *t)
+    };
+    assert_eq!(landing(&looks, 2), landing(&near, 1));
+    assert!(landing(&looks, 2).is_some());
+    let (_, near_last) = near.last().unwrap();
+    for k in 0..3 {
+        assert!(
+            (near_last[1][k] - last[2][k]).abs() < 1e-6 * h.max(1.0),
+            "{k}: {} vs {}",
+            near_last[1][k],
+            last[2][k]
+        );
+    }
 }

@@ -32,11 +32,11 @@ fn closed_between_moving(
 impl Engine {
     pub(super) fn set_active(&mut self) {
         for a in &self.active {
-            self.is_active[a.block * self.k_slots + a.slot] = false;
+            self.is_active.set(a.block, a.slot, false);
         }
         std::mem::swap(&mut self.active, &mut self.new_active);
         for a in &self.active {
-            self.is_active[a.block * self.k_slots + a.slot] = true;
+            self.is_active.set(a.block, a.slot, true);
         }
     }
 
@@ -64,10 +64,9 @@ impl Engine {
             {
                 let view = self.view();
                 let (rc, tol, eps, vapp) = (&self.rc, &self.tol, self.eps_gap, self.v_app);
-                let k = self.k_slots;
                 let is_active = &self.is_active;
                 self.for_each_slot(&view, |i, slot| {
-                    if is_active[i * k + slot] {
+                    if is_active.contains(i, slot) {
                         return;
                     }
                     let Some((_, kk)) = closed_between_moving(rc, &view, i, slot, eps) else {

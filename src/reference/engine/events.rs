@@ -40,13 +40,12 @@ impl Engine {
             pos: &self.pos,
         };
         let mut deepest = self.dynamics.gap.iter().cloned().fold(0.0f64, f64::min);
-        let k = self.k_slots;
         let rc = &self.rc;
         let is_active = &self.is_active;
         let eps = self.eps_gap;
         let vapp = self.v_app;
         self.for_each_slot(&view, |i, slot| {
-            if is_active[i * k + slot] || event {
+            if is_active.contains(i, slot) || event {
                 return;
             }
             let Some(g) = rc.geom(&view, i, slot) else {
@@ -104,6 +103,6 @@ impl Engine {
         } else {
             self.project();
         }
-        self.eval_k0()
+        self.eval_k0(true)
     }
 }

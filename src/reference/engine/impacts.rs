@@ -7,7 +7,7 @@
 //! tail at rest behind the wave would take a vanishing share of the impulse; if
 //! the impact drives a block into it, that is a new impact which wakes it).
 
-use super::super::geometry::{surface, Surface};
+use super::super::geometry::{partner, surface, Surface};
 use super::{Engine, EngineError, ImpactBuffers};
 use crate::coupling::Resolution;
 use crate::domino::Ground;
@@ -114,6 +114,7 @@ impl Engine {
         let view = self.view();
         buf.linked.clear();
         buf.linked.resize(nb, false);
+        buf.far_links.clear();
         buf.closed.clear();
         self.for_each_slot(&view, |i, slot| {
             let Some(g) = self.rc.geom(&view, i, slot) else {
@@ -121,8 +122,15 @@ impl Engine {
             };
             if g.valid && g.gap <= self.eps_gap {
                 buf.closed.push((i, slot));
-                if surface(slot, lambda) == Surface::Block && i >= self.lo && i + 1 < self.hi {
-                    buf.linked[i - self.lo] = true;
+                let Some(j) = partner(i, slot, lambda) else {
+                    return;
+                };
+                if i >= self.lo && j < self.hi {
+                    if j == i + 1 {
+                        buf.linked[i - self.lo] = true;
+                    } else {
+                        buf.far_links.push((i - self.lo, j - self.lo));
+                    }
                 }
             }
         });
@@ -136,15 +144,29 @@ impl Engine {
                 }
             }
         }
-        // spread along links (both directions)
-        for b in 0..nb.saturating_sub(1) {
-            if buf.in_group[b] && buf.linked[b] {
-                buf.in_group[b + 1] = true;
+        // spread along links (both directions), then along the links
+        // between blocks that are not neighbours, until nothing joins
+        loop {
+            for b in 0..nb.saturating_sub(1) {
+                if buf.in_group[b] && buf.linked[b] {
+                    buf.in_group[b + 1] = true;
+                }
             }
-        }
-        for b in (0..nb.saturating_sub(1)).rev() {
-            if buf.in_group[b + 1] && buf.linked[b] {
-                buf.in_group[b] = true;
+            for b in (0..nb.saturating_sub(1)).rev() {
+                if buf.in_group[b + 1] && buf.linked[b] {
+                    buf.in_group[b] = true;
+                }
+            }
+            let mut joined = false;
+            for &(a, b) in &buf.far_links {
+                if buf.in_group[a] != buf.in_group[b] {
+                    buf.in_group[a] = true;
+                    buf.in_group[b] = true;
+                    joined = true;
+                }
+            }
+            if !joined {
+                break;
             }
         }
     }
@@ -227,7 +249,7 @@ impl Engine {
             .solve_into(
                 &buf.bodies,
                 &buf.contacts,
-                &self.s.impact,
+                &self.impact,
                 &self.policy,
                 &mut buf.outcome,
             )

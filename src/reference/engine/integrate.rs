@@ -34,7 +34,11 @@ fn rhs(
 }
 
 impl Engine {
-    pub(super) fn eval_k0(&mut self) -> Result<(), EngineError> {
+    /// The derivative at the state, and the references of the events for
+    /// the next step. `after_mode`: the contact mode was chosen at this
+    /// state (an event, a window change); otherwise the mode is the one
+    /// held since the last event.
+    pub(super) fn eval_k0(&mut self, after_mode: bool) -> Result<(), EngineError> {
         self.k0.resize(self.y.len(), 0.0);
         self.evaluations += 1;
         if !rhs(
@@ -49,37 +53,60 @@ impl Engine {
         ) {
             return Err(EngineError::Singular(self.t));
         }
-        // event references at the start of the step
-        self.ref_fn.clear();
-        self.ref_stick.clear();
-        self.ref_slide.clear();
-        // A condition already violated at the start (a mode the search could
-        // not make consistent, `modes::select`) is no event: it would fire at
-        // every step and stall the run. The next event runs the search again.
+        // Event references at the start of the step. A condition already
+        // violated where the mode was chosen (a mode the search could not
+        // make consistent, `modes::select`) is no event: it would fire at
+        // every step and stall the run; the next event runs the search
+        // again. A condition that was met there and has drifted past its
+        // tolerance since, a little in each step (each step's reference is
+        // its start), is an event at once: otherwise a block whose slip
+        // reversed slowly kept its friction along the old direction, which
+        // then drove it on (seed 3, combo 2555 of the full stress sweep).
+        let same = !after_mode && self.ref_fn.len() == self.active.len();
+        if !same {
+            self.ref_fn.clear();
+            self.ref_stick.clear();
+            self.ref_slide.clear();
+        }
         let (force, slip) = (self.tol.force, 0.5 * self.v_tol);
+        // a violation: no event if it was there where the mode was chosen
+        let late = |before: Option<f64>, none: f64| match before {
+            Some(r) if r.is_finite() => 0.0,
+            _ => none,
+        };
         for (c, a) in self.active.iter().enumerate() {
+            let before = |r: &[f64]| same.then(|| r[c]);
             let fnn = self.dynamics.fn_[c];
-            self.ref_fn.push(if fnn < -force {
-                f64::NEG_INFINITY
+            let ref_fn = if fnn < -force {
+                late(before(&self.ref_fn), f64::NEG_INFINITY)
             } else {
                 fnn.min(0.0)
-            });
+            };
             let excess = self.rc.stick_excess(a.slot, self.dynamics.ft[c], fnn);
-            self.ref_stick.push(if excess > force {
-                f64::INFINITY
+            let ref_stick = if excess > force {
+                late(before(&self.ref_stick), f64::INFINITY)
             } else {
                 excess.max(0.0)
-            });
+            };
             let dir = match a.mode {
                 Mode::Slide(d) => d,
                 _ => 0.0,
             };
             let along = dir * self.dynamics.vt[c];
-            self.ref_slide.push(if along < -slip {
-                f64::NEG_INFINITY
+            let ref_slide = if along < -slip {
+                late(before(&self.ref_slide), f64::NEG_INFINITY)
             } else {
                 along.min(0.0)
-            });
+            };
+            if same {
+                self.ref_fn[c] = ref_fn;
+                self.ref_stick[c] = ref_stick;
+                self.ref_slide[c] = ref_slide;
+            } else {
+                self.ref_fn.push(ref_fn);
+                self.ref_stick.push(ref_stick);
+                self.ref_slide.push(ref_slide);
+            }
         }
         Ok(())
     }
@@ -217,7 +244,7 @@ impl Engine {
             self.handle_events()?;
         } else {
             self.project();
-            self.eval_k0()?;
+            self.eval_k0(false)?;
         }
         self.freeze()?;
         self.record();

@@ -21,6 +21,7 @@
 //! The stage files import from this file and the leaf modules of
 //! `reference` (geometry, dynamics, modes, stepper), never from each other.
 
+use std::cell::RefCell;
 use std::time::Instant;
 
 use super::dynamics::{Active, Dynamics, Mode, RowConst};
@@ -31,7 +32,7 @@ use super::snapshot::Snapshot;
 use super::stepper::Stages;
 use crate::coupling::{FallbackPolicy, GroupSolver};
 use crate::domino::{BlockSeries, ChainReport, EnergyReport, RowSpec};
-use crate::impact::{Body, Contact, ImpactOutcome};
+use crate::impact::{Body, Contact, ImpactOutcome, ImpactSettings};
 
 mod active;
 mod events;
@@ -57,6 +58,19 @@ pub enum EngineError {
     /// The contact equations became singular or the state non-finite.
     #[error("the smooth phase failed at t = {0} s (singular contact system)")]
     Singular(f64),
+    /// A start state ([`run_from`]) without one finite pose and velocity
+    /// per block of the row.
+    #[error(
+        "start state: {poses} poses and {velocities} velocities for {blocks} blocks, or not finite"
+    )]
+    InvalidStart {
+        /// Blocks in the row.
+        blocks: usize,
+        /// Poses given.
+        poses: usize,
+        /// Velocities given.
+        velocities: usize,
+    },
 }
 
 /// The result of a run.
@@ -82,6 +96,8 @@ struct ImpactBuffers {
     closed: Vec<(usize, usize)>,
     /// Window block b linked to b + 1 by a closed contact.
     linked: Vec<bool>,
+    /// Window blocks (a, b), not neighbours, linked by a closed contact.
+    far_links: Vec<(usize, usize)>,
     /// Window block b takes part in the impact.
     in_group: Vec<bool>,
     /// Window block b → its index among `bodies`.
@@ -93,14 +109,67 @@ struct ImpactBuffers {
     outcome: ImpactOutcome,
 }
 
+/// Which contacts (block, slot) are active: a flag per slot of the
+/// neighbour pairs and the ground, and the few slots between blocks that
+/// are not neighbours (`geometry::far_slot`) in a list.
+#[derive(Debug, Default)]
+struct ActiveSlots {
+    /// Slots per block with a flag ([`slots_per_block`]).
+    k_slots: usize,
+    near: Vec<bool>,
+    far: Vec<(usize, usize)>,
+}
+
+impl ActiveSlots {
+    fn new(n: usize, k_slots: usize) -> Self {
+        ActiveSlots {
+            k_slots,
+            near: vec![false; n * k_slots],
+            far: Vec::new(),
+        }
+    }
+
+    #[inline]
+    fn contains(&self, block: usize, slot: usize) -> bool {
+        if slot < self.k_slots {
+            self.near[block * self.k_slots + slot]
+        } else {
+            self.far.contains(&(block, slot))
+        }
+    }
+
+    fn set(&mut self, block: usize, slot: usize, on: bool) {
+        if slot < self.k_slots {
+            self.near[block * self.k_slots + slot] = on;
+        } else if on {
+            self.far.push((block, slot));
+        } else {
+            self.far.retain(|&e| e != (block, slot));
+        }
+    }
+}
+
+/// The broad phase of the pairs of blocks that are not neighbours
+/// (`window.rs`): blocks are sorted along the row, and a block can only
+/// touch one whose extent along x overlaps its own.
+#[derive(Debug, Default)]
+struct Reach {
+    /// The frozen blocks k < lo behind the window: the x extent (left,
+    /// right) of each and the running maximum of the right ends over
+    /// 0..=k (m), which says how far back a moving block can reach.
+    behind: Vec<[f64; 3]>,
+    /// Scratch of `for_each_slot`: per block from lo on (the window and
+    /// the untouched blocks ahead it can reach), the x extent (left,
+    /// right) and the least left end from that block on (m).
+    extents: RefCell<Vec<[f64; 3]>>,
+}
+
 /// The state of a running simulation. Private to the stage files of this
 /// folder; the rest of the crate runs it through [`run`].
 struct Engine {
     rc: RowConst,
     row: RowSpec,
     s: Settings,
-    /// Candidate slots per block ([`slots_per_block`]).
-    k_slots: usize,
     // --- window (`window.rs`)
     /// Configuration and velocity of every block (window blocks: see `y`).
     pos: Vec<[f64; 3]>,
@@ -123,7 +192,7 @@ struct Engine {
     // --- active set (`active.rs`)
     dynamics: Dynamics,
     active: Vec<Active>,
-    is_active: Vec<bool>,
+    is_active: ActiveSlots,
     candidates: Vec<Candidate>,
     mode_state: Vec<Option<Mode>>,
     new_active: Vec<Active>,
@@ -137,8 +206,13 @@ struct Engine {
     impacts_at_this_instant: usize,
     // --- impacts (`impacts.rs`)
     solver: GroupSolver,
+    /// The resolver's settings: `Settings::impact` with its rest speed
+    /// raised to the approach that starts an impact (`v_app`).
+    impact: ImpactSettings,
     policy: FallbackPolicy,
     impact_buffers: ImpactBuffers,
+    // --- broad phase of the far pairs (`window.rs`)
+    reach: Reach,
     // --- tolerances in SI
     eps_gap: f64,
     v_tol: f64,
@@ -179,7 +253,6 @@ impl Engine {
             rc,
             row: *row,
             s: settings.clone(),
-            k_slots,
             pos,
             vel,
             lo: 0,
@@ -190,10 +263,12 @@ impl Engine {
             ybest: Vec::new(),
             t: 0.0,
             active: Vec::new(),
-            is_active: vec![false; n * k_slots],
+            is_active: ActiveSlots::new(n, k_slots),
+            reach: Reach::default(),
             dynamics: Dynamics::default(),
             stages: Stages::default(),
             solver: GroupSolver::default(),
+            impact: impact_settings(settings, vbar),
             policy: impact_policy(settings),
             impact_buffers: ImpactBuffers::default(),
             hit: vec![None; n],
@@ -241,6 +316,24 @@ impl Engine {
     }
 }
 
+/// The resolver's settings for the row: `Settings::impact` with its rest
+/// speed (m/s) raised to the engine's own impact threshold
+/// `approach_tolerance · √(gh)` (`vbar`, m/s): a contact approaching slower
+/// than that does not start an impact, so an impact ends once nothing
+/// approaches faster (docs/model.md §9). Without it, two blocks wedged
+/// between opposite faces (a Table 1 T row at s/h 0.5) bounced between
+/// those faces in ever shorter cycles (e = 0.62) until the step limit, and
+/// the impact ended plastic.
+fn impact_settings(settings: &Settings, vbar: f64) -> ImpactSettings {
+    ImpactSettings {
+        rest_speed: settings
+            .impact
+            .rest_speed
+            .max(settings.approach_tolerance * vbar),
+        ..settings.impact
+    }
+}
+
 /// The fallback policy with the reference's own budgets: the held retry
 /// after `held_retry_after` resolver steps, every attempt within the
 /// resolver's step limit.
@@ -283,10 +376,66 @@ pub fn run(row: &RowSpec, settings: &Settings) -> Result<RunResult, EngineError>
 pub fn run_with_progress(
     row: &RowSpec,
     settings: &Settings,
-    mut progress: impl FnMut(usize),
+    progress: impl FnMut(usize),
 ) -> Result<RunResult, EngineError> {
     let start = Instant::now();
+    let e = Engine::new(row, settings)?;
+    drive(e, row, settings, start, progress)
+}
+
+/// Runs the reference engine on the blocks of `row` from a state of one's
+/// own: `poses[i]` = (x, y, φ) of block i (m, m, rad; y of its centre above
+/// the ground, φ counter-clockwise, 0 standing) and `velocities[i]` =
+/// (ẋ, ẏ, ω) (m/s, m/s, rad/s). Every block starts moving; `row`'s spacing
+/// and push are not used. Blocks must not overlap at the start.
+///
+/// ```
+/// use topple::domino::{Preset, RowSpec};
+/// use topple::reference::{run_from, Settings};
+/// let p = Preset::T.params();
+/// let (h, d) = (p.block.height, p.block.thickness);
+/// let row = RowSpec::new(p, 0.5 * h, 2, 1.0);
+/// // a block lying on its face, and one standing 2 h away, both at rest
+/// let poses = [[0.0, 0.5 * d, -std::f64::consts::FRAC_PI_2], [2.0 * h, 0.5 * h, 0.0]];
+/// let settings = Settings { t_max: Some(0.05), ..Settings::default() };
+/// let out = run_from(&row, &settings, &poses, &[[0.0; 3]; 2]).unwrap();
+/// assert!(out.report.max_penetration.unwrap() < 1e-6 * h);
+/// ```
+pub fn run_from(
+    row: &RowSpec,
+    settings: &Settings,
+    poses: &[[f64; 3]],
+    velocities: &[[f64; 3]],
+) -> Result<RunResult, EngineError> {
+    let start = Instant::now();
+    let n = row.n;
+    let finite = |v: &[[f64; 3]]| v.iter().flatten().all(|x| x.is_finite());
+    if poses.len() != n || velocities.len() != n || !finite(poses) || !finite(velocities) {
+        return Err(EngineError::InvalidStart {
+            blocks: n,
+            poses: poses.len(),
+            velocities: velocities.len(),
+        });
+    }
     let mut e = Engine::new(row, settings)?;
+    e.pos.copy_from_slice(poses);
+    e.vel.copy_from_slice(velocities);
+    e.lo = 0;
+    e.hi = n;
+    e.sync_in();
+    e.energy.initial = e.total_energy();
+    drive(e, row, settings, start, |_| {})
+}
+
+/// The run loop: the first events, then steps until the window is empty,
+/// the end time, the last hit (if asked) or a budget.
+fn drive(
+    mut e: Engine,
+    row: &RowSpec,
+    settings: &Settings,
+    start: Instant,
+    mut progress: impl FnMut(usize),
+) -> Result<RunResult, EngineError> {
     let t_max = settings
         .t_max
         .unwrap_or(40.0 * row.params.time_scale() * (row.n as f64 + 5.0));

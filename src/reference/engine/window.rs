@@ -4,7 +4,8 @@
 
 use super::super::dynamics::View;
 use super::super::geometry::{
-    back_top_slot, near_pair_contacts, pair_slot, surface, Corner, Side, Surface, PAIR_SLOTS,
+    back_top_slot, far_slot, near_pair_contacts, outlines_within, pair_slot, partner, x_extent,
+    Corner, Side, PAIR_SLOTS,
 };
 use super::{Engine, EngineError};
 
@@ -82,16 +83,22 @@ impl Engine {
 
     /// Every (block, slot) pair that can involve a moving block, sorted by
     /// block, at the configuration of `view`: the ground contacts of the
-    /// moving blocks, B_i and (see below) the heel of every pair, and the
+    /// moving blocks, B_i and (see below) the heel of every pair, the
     /// other corner–face contacts of a pair (`geometry::PAIR_SLOTS`) whose
-    /// corner lies within 10⁻³ h of the other block (the others cannot be
-    /// closed, so no caller needs them).
+    /// corner lies within 10⁻³ h of the other block, and the same contacts
+    /// between blocks that are not neighbours ([`Engine::far_pairs`]). The
+    /// others cannot be closed, so no caller needs them.
     pub(super) fn for_each_slot(&self, view: &View, mut f: impl FnMut(usize, usize)) {
         let lambda = self.rc.p.lambda_points;
         let n = self.row.n;
         let block = &self.rc.p.block;
         let margin = 1e-3 * block.height;
         let first = self.lo.saturating_sub(1);
+        let mut extents = self.reach.extents.borrow_mut();
+        let from = self.x_extents(view, 2.0 * margin, &mut extents);
+        for i in from..first {
+            self.far_pairs(view, i, &extents, margin, &mut f);
+        }
         for i in first..self.hi.min(n) {
             if i >= self.lo {
                 for slot in 0..=lambda {
@@ -118,10 +125,89 @@ impl Engine {
             }
             near_pair_contacts(block, view.q(i), view.q(i + 1), margin, |k| {
                 let (side, corner, _) = PAIR_SLOTS[k];
-                if heel || !(side == Side::Ahead && corner == Corner::BackBottom) {
+                if k >= 2 && (heel || !(side == Side::Ahead && corner == Corner::BackBottom)) {
                     f(i, pair_slot(k, lambda));
                 }
             });
+            if i >= from {
+                self.far_pairs(view, i, &extents, margin, &mut f);
+            }
+        }
+    }
+
+    /// The broad phase of the far pairs: into `extents`, the x extent of
+    /// every block from lo on that a moving block can reach within
+    /// `margin` (m) — the window, and the untouched blocks ahead up to the
+    /// first one beyond the window's right end (they stand where the row
+    /// put them, in order) — each with the least left end from it on.
+    /// Returns the first frozen block behind the window whose extent
+    /// reaches the window's left end (`Reach::behind`).
+    fn x_extents(&self, view: &View, margin: f64, extents: &mut Vec<[f64; 3]>) -> usize {
+        let block = &self.rc.p.block;
+        let (lo, hi) = (self.lo, self.hi);
+        let (mut left, mut right) = (f64::INFINITY, f64::NEG_INFINITY);
+        extents.clear();
+        for i in lo..hi {
+            let (a, b) = x_extent(block, view.q(i));
+            left = left.min(a);
+            right = right.max(b);
+            extents.push([a, b, 0.0]);
+        }
+        for j in hi..self.row.n {
+            let (a, b) = x_extent(block, view.q(j));
+            if a > right + margin {
+                break;
+            }
+            extents.push([a, b, 0.0]);
+        }
+        let mut least = f64::INFINITY;
+        for e in extents.iter_mut().rev() {
+            least = least.min(e[0]);
+            e[2] = least;
+        }
+        self.reach.behind.partition_point(|e| e[2] < left - margin)
+    }
+
+    /// The contacts between block `i` and the blocks j ≥ i + 2 whose x
+    /// extents overlap its own within 2 `margin` (m), at least one of the
+    /// two moving, that pass the separating-axis test and have a corner
+    /// within `margin` of the other ([`near_pair_contacts`]), given to `f`
+    /// as far slots of block i. `extents` as [`Engine::x_extents`] made
+    /// them (from block lo on); a frozen block i < lo takes its extent from
+    /// `Reach::behind` and meets only the blocks from lo on. The scan along
+    /// the row stops at the first block from which every left end lies
+    /// beyond block i's reach.
+    fn far_pairs(
+        &self,
+        view: &View,
+        i: usize,
+        extents: &[[f64; 3]],
+        margin: f64,
+        f: &mut impl FnMut(usize, usize),
+    ) {
+        let block = &self.rc.p.block;
+        let lambda = self.rc.p.lambda_points;
+        let lo = self.lo;
+        let moving = |j: usize| j >= lo && j < self.hi;
+        let grown = 2.0 * margin;
+        let [left, right, _] = if i < lo {
+            self.reach.behind[i]
+        } else {
+            extents[i - lo]
+        };
+        for j in (i + 2).max(lo)..lo + extents.len() {
+            let [a, b, least] = extents[j - lo];
+            if least > right + grown {
+                break;
+            }
+            if a > right + grown || b < left - grown || !(moving(i) || moving(j)) {
+                continue;
+            }
+            let (qi, qj) = (view.q(i), view.q(j));
+            if !outlines_within(block, qi, qj, grown) {
+                continue;
+            }
+            near_pair_contacts(block, qi, qj, margin, |k| f(i, far_slot(j - i, k, lambda)));
         }
     }
 
@@ -162,17 +248,23 @@ impl Engine {
         self.new_active.clear();
         for a in &self.active {
             let moving = |j: usize| j >= lo && j < hi;
-            let keep = if surface(a.slot, lambda) == Surface::Ground {
-                moving(a.block)
-            } else {
-                moving(a.block) && moving(a.block + 1)
-            };
+            let keep = moving(a.block) && partner(a.block, a.slot, lambda).is_none_or(moving);
             if keep {
                 self.new_active.push(*a);
             }
         }
+        // the frozen blocks behind the window: their x extents and the
+        // running maximum of the right ends (`Reach::behind`)
+        let block = &self.rc.p.block;
+        let behind = &mut self.reach.behind;
+        behind.truncate(lo);
+        while behind.len() < lo {
+            let (left, right) = x_extent(block, self.pos[behind.len()]);
+            let before = behind.last().map_or(f64::NEG_INFINITY, |e| e[2]);
+            behind.push([left, right, before.max(right)]);
+        }
         self.set_active();
         self.sync_in();
-        self.eval_k0()
+        self.eval_k0(true)
     }
 }
