@@ -100,53 +100,32 @@ fn measure(app: &mut App, frames: usize, ground_y: f32) -> Run {
     run
 }
 
-/// `--budget=WORK`: the step work budget instead of topple's default.
-fn budget() -> Option<u64> {
+/// The value of `--NAME=VALUE` on the command line, if given. Flags:
+/// `--budget=WORK` (the step work budget instead of topple's default),
+/// `--tolerance=TOL` (the time-domain resolver at this tolerance instead of
+/// the default 2·10⁻⁷), `--impulse=TOL` (the adaptive impulse stepping, the
+/// default before the time-domain resolver).
+fn flag<T: std::str::FromStr>(name: &str) -> Option<T> {
+    let prefix = format!("--{name}=");
     std::env::args().find_map(|a| {
-        a.strip_prefix("--budget=")
-            .map(|v| v.parse().expect("--budget=WORK"))
-    })
-}
-
-/// `--tolerance=TOL`: the time-domain resolver at this tolerance
-/// (`ImpactSettings::adaptive`) instead of topple's default (the same
-/// resolver at 2·10⁻⁷).
-fn tolerance() -> Option<f64> {
-    std::env::args().find_map(|a| {
-        a.strip_prefix("--tolerance=")
-            .map(|v| v.parse().expect("--tolerance=TOL"))
-    })
-}
-
-/// `--impulse=TOL`: the adaptive impulse stepping at this tolerance
-/// (`ImpactSettings::adaptive_impulse`, the default before the time-domain
-/// resolver).
-fn impulse() -> Option<f64> {
-    std::env::args().find_map(|a| {
-        a.strip_prefix("--impulse=")
-            .map(|v| v.parse().expect("--impulse=TOL"))
+        a.strip_prefix(&prefix).map(|v| {
+            v.parse()
+                .unwrap_or_else(|_| panic!("--{name}={v}: not a number"))
+        })
     })
 }
 
 fn with_budget(app: &mut App) {
-    if let Some(t) = tolerance() {
-        app.world_mut()
-            .resource_mut::<topple::bevy::ToppleConfig>()
-            .settings
-            .impact = topple::impact::ImpactSettings::adaptive(t);
+    let mut config = app.world_mut().resource_mut::<topple::bevy::ToppleConfig>();
+    let settings = &mut config.settings;
+    if let Some(t) = flag("tolerance") {
+        settings.impact = topple::impact::ImpactSettings::adaptive(t);
     }
-    if let Some(t) = impulse() {
-        app.world_mut()
-            .resource_mut::<topple::bevy::ToppleConfig>()
-            .settings
-            .impact = topple::impact::ImpactSettings::adaptive_impulse(t);
+    if let Some(t) = flag("impulse") {
+        settings.impact = topple::impact::ImpactSettings::adaptive_impulse(t);
     }
-    if let Some(w) = budget() {
-        app.world_mut()
-            .resource_mut::<topple::bevy::ToppleConfig>()
-            .settings
-            .fallback
-            .max_work = Some(w);
+    if let Some(w) = flag("budget") {
+        settings.fallback.max_work = Some(w);
     }
 }
 
