@@ -98,6 +98,22 @@ impl Integrator {
         }
     }
 
+    /// Whether point `i` touches (q = 0) without separating (its rate
+    /// within the switch's rounding, 2 × `Scales::rate`, of zero) and is
+    /// pushed in by the other forces (δ̈ < 0 in `slope`, dy/dt at the
+    /// present state): it loads again at once (an e = 0 point whose
+    /// compression has just ended and that is pushed again, cycle after
+    /// cycle), so a sliding patch of it need not go idle and come back at a
+    /// switch of its own one rounding later.
+    fn pushed_in(&self, i: usize, slope: &[f64]) -> bool {
+        let row = &self.rows[i];
+        let q = self.y[self.layout.q(i)];
+        self.points[i].mode == PointMode::Compress
+            && q.abs() <= row.q_zero
+            && normal_rate(row, &self.y) <= 2.0 * self.scales.rate
+            && normal_rate(row, slope) < -self.scales.accel
+    }
+
     fn settle_patches(&mut self, slope: &[f64]) -> bool {
         let thr = self.scales.rate;
         let mut changed = false;
@@ -107,7 +123,13 @@ impl Integrator {
             let members = &self.members[patch.first..patch.first + patch.count];
             let slip = rate(&self.y, patch.a, patch.b, &patch.tangent);
             let now = self.patch_modes[p];
-            let next = if patch.frictionless() || !members.iter().any(|&i| self.carries_load(i)) {
+            // a sliding patch whose points are unloaded but pushed in at
+            // once keeps sliding: its friction −μ s N grows from zero with
+            // the load, the direction of its slip is unchanged
+            let loaded = members.iter().any(|&i| self.carries_load(i))
+                || (matches!(now, PatchMode::Slide(s) if s * slip > thr)
+                    && members.iter().any(|&i| self.pushed_in(i, slope)));
+            let next = if patch.frictionless() || !loaded {
                 // no load, no friction: a stuck row without load would
                 // carry whatever force the other stuck rows leave it
                 PatchMode::Idle
