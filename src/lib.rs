@@ -41,6 +41,7 @@
 pub mod atomic;
 #[cfg(feature = "bevy")]
 pub mod bevy;
+mod clock;
 pub mod coupling;
 pub mod domino;
 pub mod engines;

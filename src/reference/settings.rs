@@ -113,6 +113,13 @@ pub struct Settings {
     /// Stop after this much wall-clock time (s), keeping what was measured
     /// (the report's `stopped_early` is then true); default: no limit.
     pub wall_time_limit: Option<f64>,
+    /// Stop after this much CPU time (s) of the thread that runs it, keeping
+    /// what was measured (`stopped_early` is then true): unlike
+    /// [`Settings::wall_time_limit`], other programs on a loaded machine do
+    /// not use it up; default: no limit. (CPU time where the system has a
+    /// per-thread CPU clock, Unix; elsewhere wall-clock time.)
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub cpu_time_limit: Option<f64>,
     /// Stop after this many accepted integration steps, keeping what was
     /// measured (`stopped_early` is then true): a bound on a run's work
     /// that, unlike [`Settings::wall_time_limit`], ends a run at the same
@@ -147,6 +154,7 @@ impl Default for Settings {
             stop_at_last_hit: true,
             after_last_hit: 0.0,
             wall_time_limit: None,
+            cpu_time_limit: None,
             max_steps: None,
             t_max: None,
             series_blocks: Vec::new(),

@@ -51,13 +51,19 @@ pub struct Observation {
     /// [`Observation::fallen_rock_back`] on the same row (`None` if it could
     /// not be run).
     pub reference_rock_back: Option<f64>,
+    /// Blocks (1-based) that came back below [`FALLEN_TILT`] after passing
+    /// it, in the order they first did.
+    pub stood_up: Vec<usize>,
     /// Blocks hit by the wave.
     pub hits: usize,
     /// The run did not end within its budget (its engine's own limits or the
-    /// sweep's wall-clock budget).
+    /// sweep's budget of CPU time).
     pub over_budget: bool,
-    /// Wall-clock time of the run (s).
+    /// Wall-clock time of the run (s), reported.
     pub wall: f64,
+    /// CPU time of the run (s), the thread that ran it: what the budget
+    /// bounds.
+    pub cpu: f64,
     /// The impacts, checked independently (see [`crate::impact::audit`]).
     pub audit: AuditSummary,
     /// An error the engine returned (the run could not be done).
@@ -147,7 +153,7 @@ impl RowWatch {
         }
         let fallen = blocks.iter().filter(|b| b[2].abs() > FALLEN_TILT).count();
         self.peak.resize(blocks.len(), 0.0);
-        for (b, peak) in blocks.iter().zip(&mut self.peak) {
+        for (k, (b, peak)) in blocks.iter().zip(&mut self.peak).enumerate() {
             let tilt = b[2].abs();
             *peak = peak.max(tilt);
             if *peak > FALLEN_TILT {
@@ -155,6 +161,9 @@ impl RowWatch {
                 self.seen.fallen_rock_back = self.seen.fallen_rock_back.max(back);
                 if tilt <= FALLEN_TILT {
                     self.seen.stood_up_rock_back = self.seen.stood_up_rock_back.max(back);
+                    if !self.seen.stood_up.contains(&(k + 1)) {
+                        self.seen.stood_up.push(k + 1);
+                    }
                 }
             }
         }

@@ -20,7 +20,7 @@ pub struct SoakSpec {
     pub cycle: f64,
     /// The Rapier build.
     pub precision: Precision,
-    /// Wall-clock budget of each run (s).
+    /// Budget of each run (s of CPU time of the thread that runs it).
     pub budget: f64,
 }
 

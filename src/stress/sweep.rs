@@ -20,7 +20,8 @@ pub struct SweepSpec {
     pub n_lo: usize,
     /// See `n_lo`.
     pub n_hi: usize,
-    /// Wall-clock budget of one run (s).
+    /// Budget of one run (s of CPU time of the thread that runs it, so that
+    /// the verdict does not depend on the machine's load).
     pub budget: f64,
     /// The full sweep (for the reproduce line).
     pub full: bool,
@@ -235,7 +236,7 @@ pub fn violations(c: &Combo, o: &Observation) -> Vec<Violation> {
 fn describe(c: &Combo, o: &Observation) -> String {
     let p = &c.row.params;
     format!(
-        "{} {} s/h {:.3} n {} push {:.2} μ1 {:.2} μ2 {:.2} e1 {} e2 {} dt {:.2e}: {} hits, {} impacts, penetration {}{}",
+        "{} {} s/h {:.3} n {} push {:.2} μ1 {:.2} μ2 {:.2} e1 {} e2 {} dt {:.2e}: {} hits, {} impacts, {:.1} s of CPU, penetration {}{}{}",
         c.engine.name(),
         c.preset,
         c.row.spacing_ratio(),
@@ -248,7 +249,21 @@ fn describe(c: &Combo, o: &Observation) -> String {
         c.dt,
         o.hits,
         o.audit.impacts,
+        o.cpu,
         o.penetration_at,
+        if o.fallen_drop > 0 {
+            format!(
+                ", fallen count dropped by {} (stood up: blocks {:?}; rock-back {:.2}°{})",
+                o.fallen_drop,
+                o.stood_up,
+                o.stood_up_rock_back.to_degrees(),
+                o.reference_rock_back
+                    .map(|r| format!(", reference's {:.2}°", r.to_degrees()))
+                    .unwrap_or_default(),
+            )
+        } else {
+            String::new()
+        },
         o.error.as_deref().map(|e| format!(", error: {e}")).unwrap_or_default()
     )
 }
@@ -266,7 +281,7 @@ pub struct SweepResult {
     pub worst: BTreeMap<Kind, f64>,
     /// Every violation.
     pub violations: Vec<Violation>,
-    /// Wall-clock time of the longest run (s).
+    /// CPU time of the longest run (s).
     pub longest_run: f64,
     /// Worst penetration (over h) per engine and time step (µs).
     pub penetration: BTreeMap<(StressEngine, u64), f64>,
@@ -320,7 +335,7 @@ pub fn sweep(
         *r.runs.entry(c.engine).or_default() += 1;
         r.impacts += o.audit.impacts;
         r.elastic_impacts += o.audit.elastic_impacts;
-        r.longest_run = r.longest_run.max(o.wall);
+        r.longest_run = r.longest_run.max(o.cpu);
         if c.engine != StressEngine::Impact {
             let w = r
                 .penetration
@@ -373,7 +388,7 @@ pub fn table(spec: &SweepSpec, r: &SweepResult) -> String {
     );
     let _ = writeln!(
         s,
-        "longest run {:.1} s (budget {} s)",
+        "longest run {:.1} s of CPU (budget {} s of CPU per run)",
         r.longest_run, spec.budget
     );
     let _ = writeln!(

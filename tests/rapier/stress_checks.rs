@@ -83,6 +83,7 @@ fn overlap_and_a_fallen_block_standing_up_are_seen() {
     w.look(0.0, &[[0.0, 0.05, -1.0]]);
     w.look(0.0, &[[0.0, 0.05, 0.0]]);
     assert_eq!(w.seen.fallen_drop, 1);
+    assert_eq!(w.seen.stood_up, vec![1]);
     // it came back 1 rad from its largest tilt
     assert_eq!(w.seen.stood_up_rock_back, 1.0);
     assert_eq!(w.seen.fallen_rock_back, 1.0);
@@ -93,6 +94,7 @@ fn overlap_and_a_fallen_block_standing_up_are_seen() {
     w.look(0.1, &[[0.0, 0.05, -0.78], [0.2, 0.05, -1.1]]);
     assert_eq!(w.seen.fallen_drop, 1);
     assert!((w.seen.stood_up_rock_back - 0.02).abs() < 1e-12);
+    assert_eq!(w.seen.stood_up, vec![1], "only the first stood up");
     assert!((w.seen.fallen_rock_back - 0.1).abs() < 1e-12);
     let mut w = RowWatch::new(0.1, 0.02);
     w.look(0.0, &[[0.0, f64::NAN, 0.0]]);

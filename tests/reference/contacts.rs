@@ -244,6 +244,30 @@ fn a_step_bound_stops_a_run_where_it_says() {
     assert!(bounded.report.hit_times.len() < row.n);
 }
 
+/// `Settings::cpu_time_limit` stops a run once the thread that runs it has
+/// used that much CPU time, and says so; checked against the wall clock (a
+/// thread cannot use more CPU time than the time that passes) and against
+/// the unbounded run of the same row (the bounded run ends earlier).
+#[test]
+fn a_cpu_time_bound_stops_a_run_and_says_so() {
+    let p = Preset::X.params();
+    let row = RowSpec::new(p, 0.52 * p.block.height, 12, 1.0);
+    let settings = |limit| Settings {
+        cpu_time_limit: limit,
+        max_steps: Some(3_000),
+        ..Default::default()
+    };
+    let free = run(&row, &settings(None)).unwrap();
+    assert_eq!(free.steps, 3_000, "the step bound ends the free run");
+    let wall = std::time::Instant::now();
+    let bounded = run(&row, &settings(Some(0.0))).unwrap();
+    let wall = wall.elapsed().as_secs_f64();
+    assert!(bounded.report.stopped_early);
+    assert!(bounded.steps < free.steps, "{} steps", bounded.steps);
+    // a zero budget ends the run at its first check, before any step
+    assert_eq!(bounded.steps, 0, "{wall} s");
+}
+
 /// Combo 2555 of the full sweep's seed 3 (Domino X, s/h 0.113, e1 0.85,
 /// Δt 0.1 ms, 13 blocks; the wave stops at block 6): block 4, standing
 /// again after rocking for 3 s, slid forward on its feet from t = 3.56 s,

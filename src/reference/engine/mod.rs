@@ -454,6 +454,7 @@ fn drive(
     e.record();
     let mut stopped_early = false;
     let mut hits_seen = 0;
+    let cpu = crate::clock::CpuWatch::start();
     while e.lo < e.hi && e.t < t_max {
         if settings.stop_at_last_hit
             && e.hit[row.n - 1].is_some_and(|t| e.t >= t + settings.after_last_hit)
@@ -467,6 +468,10 @@ fn drive(
         if let Some(limit) = settings.wall_time_limit
             && start.elapsed().as_secs_f64() > limit
         {
+            stopped_early = true;
+            break;
+        }
+        if settings.cpu_time_limit.is_some_and(|l| cpu.seconds() >= l) {
             stopped_early = true;
             break;
         }

@@ -43,7 +43,7 @@ pub struct SceneSpec {
     pub n_hi: usize,
     /// Simulated time of a scene (s).
     pub duration: f64,
-    /// Wall-clock budget of one run (s).
+    /// Budget of one run (s of CPU time of the thread that runs it).
     pub budget: f64,
     /// The full sweep (for the reproduce line).
     pub full: bool,
@@ -218,7 +218,7 @@ pub struct SceneResult {
     pub per_engine: BTreeMap<SceneEngine, (f64, u64, f64)>,
     /// Every violation.
     pub violations: Vec<Violation>,
-    /// Wall-clock time of the longest scene (both runs, s).
+    /// CPU time of the longest scene (both runs, s).
     pub longest_run: f64,
     /// The scene and what it showed, when one alone was run.
     pub single: Option<(SceneCombo, SceneObservation)>,
@@ -309,7 +309,7 @@ pub fn scene_sweep(
         *r.runs.entry(c.engine).or_default() += 1;
         r.impacts += o.audit.impacts;
         r.frames += o.frames;
-        r.longest_run = r.longest_run.max(o.wall);
+        r.longest_run = r.longest_run.max(o.cpu);
         r.coverage.add(c);
         r.within_native += within_native(c, o) as usize;
         *r.tunnelled.entry(c.engine).or_default() += o.tunnelled;
@@ -384,7 +384,7 @@ pub fn scene_table(spec: &SceneSpec, r: &SceneResult) -> String {
     );
     let _ = writeln!(
         s,
-        "longest scene {:.1} s (budget {} s per run, two runs each and native once)",
+        "longest scene {:.1} s of CPU (budget {} s of CPU per run, two runs each and native once)",
         r.longest_run, spec.budget
     );
     let _ = writeln!(
