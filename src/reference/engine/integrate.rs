@@ -6,7 +6,7 @@ use super::super::dynamics::Active;
 use super::super::dynamics::{Dynamics, Mode, RowConst, View};
 use super::super::settings::Integrator;
 use super::super::stepper::{DOPRI5, HEUN};
-use super::{Engine, EngineError};
+use super::{Engine, EngineError, EventKey};
 
 fn rhs(
     dynamics: &mut Dynamics,
@@ -53,6 +53,10 @@ impl Engine {
         ) {
             return Err(EngineError::Singular(self.t));
         }
+        let d = &self.dynamics;
+        self.start_forces.clear();
+        self.start_forces
+            .extend((0..self.active.len()).map(|c| [d.fn_[c], d.ft[c], d.vt[c]]));
         // Event references at the start of the step. A condition already
         // violated where the mode was chosen (a mode the search could not
         // make consistent, `modes::select`) is no event: it would fire at
@@ -176,7 +180,8 @@ impl Engine {
     /// within `Settings::event_time_tolerance`, its state left in `ybest`.
     ///
     /// The search keeps the bracket [a, b] (no event at a, an event at b)
-    /// and follows one condition that is violated at b (`EventProbe`):
+    /// and follows one condition that is violated at b (`EventProbe`), its
+    /// margin at a = 0 taken from the step start (`start_margin`):
     /// with that condition's margin measured at both ends, the next trial
     /// length is the regula falsi point of the margin, with the Illinois
     /// modification (the margin kept at an end that stays twice in a row is
@@ -197,7 +202,10 @@ impl Engine {
         // the followed condition's margin at a (≤ 0) and at b (> 0)
         let first = self.probe.first.filter(|(_, m)| m.is_finite());
         self.probe.watch = first.map(|(key, _)| key);
-        let (mut fa, mut fb): (Option<f64>, Option<f64>) = (None, first.map(|(_, m)| m));
+        let (mut fa, mut fb): (Option<f64>, Option<f64>) = (
+            first.and_then(|(key, _)| self.start_margin(key)),
+            first.map(|(_, m)| m),
+        );
         // which end the last trials moved (-1: a, +1: b), for Illinois
         let mut last_side = 0i8;
         let mut widths = [h; 3];
@@ -250,6 +258,40 @@ impl Engine {
         }
         self.probe.watch = None;
         b
+    }
+
+    /// The margin of an event condition (`EventProbe`) at the step start,
+    /// if it has one there and it is not violated: from the forces of
+    /// `eval_k0` for an active contact, from the geometry at `y` for a
+    /// candidate closing.
+    fn start_margin(&self, key: EventKey) -> Option<f64> {
+        let (force, slip) = (self.tol.force, 0.5 * self.v_tol);
+        let margin = match key {
+            EventKey::Lift(c) => {
+                let [fnn, _, _] = *self.start_forces.get(c)?;
+                (self.ref_fn[c] - force - fnn) / force
+            }
+            EventKey::Stick(c) => {
+                let [fnn, ft, _] = *self.start_forces.get(c)?;
+                let excess = self.rc.stick_excess(self.active[c].slot, ft, fnn);
+                (excess - (self.ref_stick[c] + force)) / force
+            }
+            EventKey::Slide(c) => {
+                let [_, _, vt] = *self.start_forces.get(c)?;
+                let Mode::Slide(dir) = self.active[c].mode else {
+                    return None;
+                };
+                (self.ref_slide[c] - slip - dir * vt) / slip
+            }
+            EventKey::Close(i, slot) => {
+                let g = self.rc.geom(&self.view(), i, slot)?;
+                if !g.valid {
+                    return None;
+                }
+                (-self.eps_gap - g.gap) / self.eps_gap
+            }
+        };
+        (margin.is_finite() && margin <= 0.0).then_some(margin)
     }
 
     /// Advances by one accepted step (possibly shortened to an event).

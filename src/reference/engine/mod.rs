@@ -229,6 +229,9 @@ struct Engine {
     last_impact_time: f64,
     impacts_at_this_instant: usize,
     probe: EventProbe,
+    /// F_n, F_t (N) and v_t (m/s) of each active contact at the step start
+    /// (`eval_k0`): the event margins there, for the event location.
+    start_forces: Vec<[f64; 3]>,
     // --- impacts (`impacts.rs`)
     solver: GroupSolver,
     /// The resolver's settings: `Settings::impact` with its rest speed
@@ -306,6 +309,7 @@ impl Engine {
             last_impact_time: f64::NEG_INFINITY,
             impacts_at_this_instant: 0,
             probe: EventProbe::default(),
+            start_forces: Vec::new(),
             steps: 0,
             evaluations: 0,
             ref_fn: Vec::new(),
