@@ -72,15 +72,19 @@ impl Band {
                 self.rhs.swap(k, p);
             }
             let piv = self.a[self.idx(k, k)];
+            // row k's entries k..=cmax, and row r's below it: entry (r, c)
+            // is at r (width − 1) + kl + c
+            let start_k = self.idx(k, k);
             for r in k + 1..=last {
                 let f = self.a[self.idx(r, k)] / piv;
                 if f == 0.0 {
                     continue;
                 }
-                for c in k..=cmax {
-                    let v = self.a[self.idx(k, c)];
-                    let i = self.idx(r, c);
-                    self.a[i] -= f * v;
+                let start_r = self.idx(r, k);
+                let (upper, lower) = self.a.split_at_mut(start_r);
+                let row_k = &upper[start_k..=start_k + (cmax - k)];
+                for (x, v) in lower[..=cmax - k].iter_mut().zip(row_k) {
+                    *x -= f * v;
                 }
                 self.rhs[r] -= f * self.rhs[k];
             }

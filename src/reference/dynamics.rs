@@ -81,6 +81,8 @@ struct Unknown {
 pub(crate) struct Dynamics {
     band: Band,
     unknowns: Vec<Unknown>,
+    /// M⁻¹ applied to each unknown's columns (`assemble`).
+    minv_cols: Vec<[[f64; 3]; 2]>,
     geoms: Vec<Geom>,
     kins: Vec<Kin>,
     /// Normal force of each active contact (N).
@@ -253,6 +255,10 @@ impl Dynamics {
         self.band.reset(m, bw, bw);
         self.band.rhs = rhs;
         self.band.rhs.resize(m, 0.0);
+        // M⁻¹ Cᵀ of every unknown once, not once per entry of its column
+        self.minv_cols.clear();
+        self.minv_cols
+            .extend(self.unknowns.iter().map(|u| u.col.map(|c| rc.minv(c))));
         for r in 0..m {
             let ur = self.unknowns[r];
             let lo = r.saturating_sub(bw);
@@ -265,7 +271,7 @@ impl Dynamics {
                     let Some(ba) = ba else { continue };
                     for (b, bb) in us.bodies.iter().enumerate() {
                         if Some(*ba) == *bb {
-                            v += dot3(ur.row[a], rc.minv(us.col[b]));
+                            v += dot3(ur.row[a], self.minv_cols[s][b]);
                         }
                     }
                 }

@@ -215,7 +215,7 @@ fn rot(phi: f64, p: [f64; 2]) -> [f64; 2] {
 #[inline]
 fn turn(phi: f64) -> (f64, f64) {
     use std::cell::Cell;
-    const SLOTS: usize = 16;
+    const SLOTS: usize = 64;
     thread_local! {
         static SEEN: [Cell<(u64, f64, f64)>; SLOTS] =
             const { [const { Cell::new((u64::MAX, 0.0, 0.0)) }; SLOTS] };

@@ -96,6 +96,9 @@ impl Stages {
         mut f: impl FnMut(&[f64], &mut [f64]) -> bool,
     ) -> bool {
         let n = y0.len();
+        if tab.is_heun() {
+            return self.heun(h, y0, k0, y1, f);
+        }
         let s = tab.c.len();
         if self.k.len() < s {
             self.k.resize(s, Vec::new());
@@ -148,9 +151,81 @@ impl Stages {
     }
 }
 
+impl Tableau {
+    /// Whether this is [`HEUN`]'s tableau.
+    fn is_heun(&self) -> bool {
+        self.c == HEUN.c && self.a == HEUN.a && self.b == HEUN.b && self.e.is_none()
+    }
+}
+
+impl Stages {
+    /// [`Stages::step`] for [`HEUN`], written out: the same operations in
+    /// the same order as the tableau loop (so the same bits), without its
+    /// indexing (the paper's integrator runs this at every step and at every
+    /// trial of an event's location).
+    fn heun(
+        &mut self,
+        h: f64,
+        y0: &[f64],
+        k0: &[f64],
+        y1: &mut Vec<f64>,
+        mut f: impl FnMut(&[f64], &mut [f64]) -> bool,
+    ) -> bool {
+        let n = y0.len();
+        if self.k.len() < 2 {
+            self.k.resize(2, Vec::new());
+        }
+        self.tmp.resize(n, 0.0);
+        let k1 = &mut self.k[1];
+        k1.resize(n, 0.0);
+        for ((t, y), k) in self.tmp.iter_mut().zip(y0).zip(k0) {
+            *t = y + h * (0.0 + 1.0 * k);
+        }
+        if !f(&self.tmp, k1) {
+            return false;
+        }
+        y1.resize(n, 0.0);
+        for (((out, y), a), b) in y1.iter_mut().zip(y0).zip(k0).zip(k1.iter()) {
+            *out = y + h * (0.0 + 0.5 * a + 0.5 * b);
+        }
+        self.err.clear();
+        self.err.resize(n, 0.0);
+        true
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    // The written-out Heun step gives the tableau loop's bits: the same
+    // tableau with an (all-zero) error row takes the loop.
+    #[test]
+    fn heun_written_out_matches_the_tableau_loop() {
+        const LOOPED: Tableau = Tableau {
+            c: HEUN.c,
+            a: HEUN.a,
+            b: HEUN.b,
+            e: Some(&[0.0, 0.0]),
+        };
+        assert!(HEUN.is_heun() && !LOOPED.is_heun() && !DOPRI5.is_heun());
+        let y0: Vec<f64> = (0..13).map(|i| (i as f64 * 0.37).sin() - 0.2).collect();
+        let f = |y: &[f64], dy: &mut [f64]| {
+            for (i, (d, v)) in dy.iter_mut().zip(y).enumerate() {
+                *d = (v * (1.0 + i as f64)).cos() - 0.3 * v * v;
+            }
+            true
+        };
+        let mut k0 = vec![0.0; y0.len()];
+        f(&y0, &mut k0);
+        k0[3] = -0.0;
+        let (mut a, mut b) = (Vec::new(), Vec::new());
+        let mut st = Stages::default();
+        assert!(st.step(&HEUN, 0.013, &y0, &k0, &mut a, f));
+        assert!(st.step(&LOOPED, 0.013, &y0, &k0, &mut b, f));
+        let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+        assert_eq!(bits(&a), bits(&b));
+    }
 
     // y' = −y: one step's error must shrink as h^(order+1).
     #[test]

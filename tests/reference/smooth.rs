@@ -59,3 +59,55 @@ fn first_block_rotates_about_its_edge_like_a_rigid_pendulum() {
         assert!(e.residual.abs() < 1e-6 * e.initial, "{e:?}");
     }
 }
+
+/// The time the first block's front top corner B closes on the back face of
+/// the second, which the engine takes as the instant its penetration
+/// passes the gap tolerance ε = 10⁻⁶ h (`Settings::gap_tolerance`):
+/// h sin θ = s + ε (rotation about the front bottom edge, from
+/// [`pivot_theta`]'s equation with RK4 at 10⁻⁶ s, the crossing
+/// interpolated within the last step), against the engine's first hit:
+/// the event location (docs/reference-performance.md) must land on it to
+/// within the integration error, far below one time step (10⁻⁴ s).
+#[test]
+fn the_first_hit_is_located_at_the_pendulum_crossing() {
+    let p = Preset::T.params().ideal();
+    let (h, d, g) = (p.block.height, p.block.thickness, p.gravity);
+    let row = RowSpec::new(p, 0.3 * h, 3, 1.0);
+    let target = (0.3f64 + Settings::default().gap_tolerance).asin();
+    let r = 0.5 * (h * h + d * d).sqrt();
+    let phi0 = (d / h).atan();
+    let ia = (h * h + d * d) / 3.0;
+    let f = |th: f64| g * r * (th - phi0).sin() / ia;
+    let (mut th, mut w, mut t) = (0.0f64, row.push / p.time_scale(), 0.0f64);
+    let dt = 1e-6;
+    let crossing = loop {
+        let k1 = (w, f(th));
+        let k2 = (w + 0.5 * dt * k1.1, f(th + 0.5 * dt * k1.0));
+        let k3 = (w + 0.5 * dt * k2.1, f(th + 0.5 * dt * k2.0));
+        let k4 = (w + dt * k3.1, f(th + dt * k3.0));
+        let th1 = th + dt / 6.0 * (k1.0 + 2.0 * k2.0 + 2.0 * k3.0 + k4.0);
+        w += dt / 6.0 * (k1.1 + 2.0 * k2.1 + 2.0 * k3.1 + k4.1);
+        if th1 >= target {
+            break t + dt * (target - th) / (th1 - th);
+        }
+        (th, t) = (th1, t + dt);
+    };
+    for (settings, tol) in [
+        (Settings::accurate(1e-10), 1e-8),
+        (Settings::default(), 1e-6),
+    ] {
+        let out = run(
+            &row,
+            &Settings {
+                t_max: Some(1.2 * crossing),
+                ..settings
+            },
+        )
+        .unwrap();
+        let hit = out.report.hit_times[1];
+        assert!(
+            (hit - crossing).abs() < tol,
+            "hit {hit} s, crossing {crossing} s"
+        );
+    }
+}

@@ -4,35 +4,67 @@
 //! mode, the projection, the derivative for the next step.
 
 use super::super::dynamics::{Mode, View};
-use super::{Engine, EngineError};
+use super::{Engine, EngineError, EventKey};
 
 impl Engine {
     /// True if any event happened in state `y1` (the dynamics must hold the
     /// forces at `y1`). Also tracks the deepest penetration.
     pub(super) fn events_at(&mut self, y1: &[f64]) -> bool {
         let mut event = false;
+        // the margins of the conditions (> 0: violated) for `probe`; an
+        // invalid contact has none
+        let watch = self.probe.watch;
+        let mut first: Option<(EventKey, f64)> = None;
+        let mut watched: Option<f64> = None;
+        let mut note = |key: EventKey, margin: f64, violated: bool| {
+            if violated && first.is_none() {
+                first = Some((key, margin));
+            }
+            if watch == Some(key) {
+                watched = Some(margin);
+            }
+        };
         for (c, a) in self.active.iter().enumerate() {
             let d = &self.dynamics;
             let fnn = d.fn_[c];
-            if !d.valid[c] || fnn < self.ref_fn[c] - self.tol.force {
+            let lift = fnn < self.ref_fn[c] - self.tol.force;
+            if !d.valid[c] || lift {
                 event = true;
+            }
+            if d.valid[c] {
+                let margin = (self.ref_fn[c] - self.tol.force - fnn) / self.tol.force;
+                note(EventKey::Lift(c), margin, lift);
             }
             match a.mode {
                 Mode::Stick => {
-                    if self.rc.stick_excess(a.slot, d.ft[c], fnn)
-                        > self.ref_stick[c] + self.tol.force
-                    {
+                    let excess = self.rc.stick_excess(a.slot, d.ft[c], fnn);
+                    let limit = self.ref_stick[c] + self.tol.force;
+                    if excess > limit {
                         event = true;
                     }
+                    note(
+                        EventKey::Stick(c),
+                        (excess - limit) / self.tol.force,
+                        excess > limit,
+                    );
                 }
                 Mode::Slide(dir) => {
-                    if dir * d.vt[c] < self.ref_slide[c] - 0.5 * self.v_tol {
+                    let limit = self.ref_slide[c] - 0.5 * self.v_tol;
+                    if dir * d.vt[c] < limit {
                         event = true;
                     }
+                    let margin = (limit - dir * d.vt[c]) / (0.5 * self.v_tol);
+                    note(EventKey::Slide(c), margin, dir * d.vt[c] < limit);
                 }
                 Mode::Frictionless => {}
             }
         }
+        // the candidate that is followed is measured even once an event
+        // was found (the other candidates are then skipped, as before)
+        let watch_slot = match watch {
+            Some(EventKey::Close(i, slot)) => Some((i, slot)),
+            _ => None,
+        };
         let view = View {
             lo: self.lo,
             hi: self.hi,
@@ -45,7 +77,8 @@ impl Engine {
         let eps = self.eps_gap;
         let vapp = self.v_app;
         self.for_each_slot(&view, |i, slot| {
-            if is_active.contains(i, slot) || event {
+            let watched_slot = watch_slot == Some((i, slot));
+            if is_active.contains(i, slot) || (event && !watched_slot) {
                 return;
             }
             let Some(g) = rc.geom(&view, i, slot) else {
@@ -54,15 +87,24 @@ impl Engine {
             if !g.valid {
                 return;
             }
-            deepest = deepest.min(g.gap);
+            let margin = (-eps - g.gap) / eps;
+            if !event {
+                deepest = deepest.min(g.gap);
+            }
             if g.gap >= -eps {
+                if watched_slot {
+                    note(EventKey::Close(i, slot), margin, false);
+                }
                 return;
             }
             let kk = rc.kin(&view, &g);
             if kk.gdot < -vapp {
+                note(EventKey::Close(i, slot), margin, !event);
                 event = true;
             }
         });
+        self.probe.first = first;
+        self.probe.watched = watched;
         // The heel-on-front-face pairs inside the row are not contacts (see
         // for_each_slot) but their overlap is measured, so that the reported
         // penetration covers every corner the row can drive into a neighbour.

@@ -6,7 +6,7 @@ use super::super::dynamics::Active;
 use super::super::dynamics::{Dynamics, Mode, RowConst, View};
 use super::super::settings::Integrator;
 use super::super::stepper::{DOPRI5, HEUN};
-use super::{Engine, EngineError};
+use super::{Engine, EngineError, EventKey};
 
 fn rhs(
     dynamics: &mut Dynamics,
@@ -53,6 +53,10 @@ impl Engine {
         ) {
             return Err(EngineError::Singular(self.t));
         }
+        let d = &self.dynamics;
+        self.start_forces.clear();
+        self.start_forces
+            .extend((0..self.active.len()).map(|c| [d.fn_[c], d.ft[c], d.vt[c]]));
         // Event references at the start of the step. A condition already
         // violated where the mode was chosen (a mode the search could not
         // make consistent, `modes::select`) is no event: it would fire at
@@ -170,6 +174,126 @@ impl Engine {
         self.dynamics.forces(&self.rc, &view, &self.active)
     }
 
+    /// The step length in (0, `h`] that ends within the event time
+    /// tolerance after the first event of a step of length `h` whose end
+    /// has one: the earliest length at which `events_at` finds one, to
+    /// within `Settings::event_time_tolerance`, its state left in `ybest`.
+    ///
+    /// The search keeps the bracket [a, b] (no event at a, an event at b)
+    /// and follows one condition that is violated at b (`EventProbe`), its
+    /// margin at a = 0 taken from the step start (`start_margin`):
+    /// with that condition's margin measured at both ends, the next trial
+    /// length is the regula falsi point of the margin, with the Illinois
+    /// modification (the margin kept at an end that stays twice in a row is
+    /// halved) so that both ends close in; without both margins (a
+    /// condition that has no continuous margin, a singular trial, a new
+    /// condition taking over), the midpoint. A trial point is kept at least
+    /// half the tolerance inside the bracket, and a bracket that has not
+    /// halved in three trials is bisected, so the search never takes more
+    /// trials than about three times the bisection it replaces (about 20
+    /// trials for Δt = 10⁻⁴ s and 10⁻¹⁰ s) and usually far fewer, the
+    /// margins being smooth in the step length. The event, and so the
+    /// state at which it is handled, is the same as by bisection: the
+    /// first step length at which the test fires, to the same tolerance.
+    fn locate_event(&mut self, h: f64) -> f64 {
+        let tol = self.s.event_time_tolerance;
+        let finite = |m: Option<f64>| m.filter(|m| m.is_finite());
+        let (mut a, mut b) = (0.0, h);
+        // the followed condition's margin at a (≤ 0) and at b (> 0)
+        let first = self.probe.first.filter(|(_, m)| m.is_finite());
+        self.probe.watch = first.map(|(key, _)| key);
+        let (mut fa, mut fb): (Option<f64>, Option<f64>) = (
+            first.and_then(|(key, _)| self.start_margin(key)),
+            first.map(|(_, m)| m),
+        );
+        // which end the last trials moved (-1: a, +1: b), for Illinois
+        let mut last_side = 0i8;
+        let mut widths = [h; 3];
+        let mut trials = 0usize;
+        while b - a > tol {
+            trials += 1;
+            let halving_stalled = trials > 3 && b - a > 0.5 * widths[trials % 3];
+            widths[trials % 3] = b - a;
+            let mid = 0.5 * (a + b);
+            let t = match (fa, fb) {
+                (Some(ma), Some(mb)) if !halving_stalled && mb > ma => {
+                    let t = a + (b - a) * (-ma / (mb - ma));
+                    t.clamp(a + 0.5 * tol, b - 0.5 * tol)
+                }
+                _ => mid,
+            };
+            let ok = self.trial(t) && self.forces_at_y1();
+            let y1 = std::mem::take(&mut self.y1);
+            let ev = !ok || self.events_at(&y1);
+            self.y1 = y1;
+            let watched = if ok { finite(self.probe.watched) } else { None };
+            if ev {
+                b = t;
+                self.ybest.clone_from(&self.y1);
+                match watched.filter(|m| *m > 0.0) {
+                    Some(m) => {
+                        fb = Some(m);
+                        if last_side == 1 {
+                            fa = fa.map(|v| 0.5 * v);
+                        }
+                    }
+                    None => {
+                        // another condition fires first: follow it
+                        let next = if ok { self.probe.first } else { None };
+                        let next = next.filter(|(_, m)| m.is_finite());
+                        self.probe.watch = next.map(|(key, _)| key);
+                        fb = next.map(|(_, m)| m);
+                        fa = None;
+                    }
+                }
+                last_side = 1;
+            } else {
+                a = t;
+                fa = watched.filter(|m| *m <= 0.0);
+                if last_side == -1 {
+                    fb = fb.map(|v| 0.5 * v);
+                }
+                last_side = -1;
+            }
+        }
+        self.probe.watch = None;
+        b
+    }
+
+    /// The margin of an event condition (`EventProbe`) at the step start,
+    /// if it has one there and it is not violated: from the forces of
+    /// `eval_k0` for an active contact, from the geometry at `y` for a
+    /// candidate closing.
+    fn start_margin(&self, key: EventKey) -> Option<f64> {
+        let (force, slip) = (self.tol.force, 0.5 * self.v_tol);
+        let margin = match key {
+            EventKey::Lift(c) => {
+                let [fnn, _, _] = *self.start_forces.get(c)?;
+                (self.ref_fn[c] - force - fnn) / force
+            }
+            EventKey::Stick(c) => {
+                let [fnn, ft, _] = *self.start_forces.get(c)?;
+                let excess = self.rc.stick_excess(self.active[c].slot, ft, fnn);
+                (excess - (self.ref_stick[c] + force)) / force
+            }
+            EventKey::Slide(c) => {
+                let [_, _, vt] = *self.start_forces.get(c)?;
+                let Mode::Slide(dir) = self.active[c].mode else {
+                    return None;
+                };
+                (self.ref_slide[c] - slip - dir * vt) / slip
+            }
+            EventKey::Close(i, slot) => {
+                let g = self.rc.geom(&self.view(), i, slot)?;
+                if !g.valid {
+                    return None;
+                }
+                (-self.eps_gap - g.gap) / self.eps_gap
+            }
+        };
+        (margin.is_finite() && margin <= 0.0).then_some(margin)
+    }
+
     /// Advances by one accepted step (possibly shortened to an event).
     pub(super) fn advance(&mut self, t_end: f64) -> Result<(), EngineError> {
         let mut h = match self.s.integrator {
@@ -214,22 +338,8 @@ impl Engine {
         self.y1 = y1;
         if ev {
             event = true;
-            let (mut a, mut b) = (0.0, h);
             self.ybest.clone_from(&self.y1);
-            while b - a > self.s.event_time_tolerance {
-                let mid = 0.5 * (a + b);
-                let ok = self.trial(mid) && self.forces_at_y1();
-                let y1 = std::mem::take(&mut self.y1);
-                let ev = !ok || self.events_at(&y1);
-                self.y1 = y1;
-                if ev {
-                    b = mid;
-                    self.ybest.clone_from(&self.y1);
-                } else {
-                    a = mid;
-                }
-            }
-            h = b;
+            h = self.locate_event(h);
             std::mem::swap(&mut self.y1, &mut self.ybest);
             h_next = h_next.max(1e-3 * self.rc.p.time_scale().min(h_next));
         }

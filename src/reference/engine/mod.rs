@@ -149,6 +149,30 @@ impl ActiveSlots {
     }
 }
 
+/// One event condition of a step (`events.rs`), followed while the step is
+/// shortened to the event (`integrate.rs`): lift-off, stick → slip or slip
+/// reversal of active contact c, or candidate (block, slot) closing.
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum EventKey {
+    Lift(usize),
+    Stick(usize),
+    Slide(usize),
+    Close(usize, usize),
+}
+
+/// What `events_at` tells the event location besides whether an event
+/// happened: the first condition it found violated, with its margin, and
+/// the margin of the condition being followed (`watch`), if it could be
+/// measured. A margin is the condition's value past its threshold in units
+/// of its tolerance (force, velocity or gap): > 0 exactly where the
+/// condition calls an event.
+#[derive(Debug, Default)]
+struct EventProbe {
+    watch: Option<EventKey>,
+    first: Option<(EventKey, f64)>,
+    watched: Option<f64>,
+}
+
 /// The broad phase of the pairs of blocks that are not neighbours
 /// (`window.rs`): blocks are sorted along the row, and a block can only
 /// touch one whose extent along x overlaps its own.
@@ -204,6 +228,10 @@ struct Engine {
     /// row have found an impact at that same instant.
     last_impact_time: f64,
     impacts_at_this_instant: usize,
+    probe: EventProbe,
+    /// F_n, F_t (N) and v_t (m/s) of each active contact at the step start
+    /// (`eval_k0`): the event margins there, for the event location.
+    start_forces: Vec<[f64; 3]>,
     // --- impacts (`impacts.rs`)
     solver: GroupSolver,
     /// The resolver's settings: `Settings::impact` with its rest speed
@@ -280,6 +308,8 @@ impl Engine {
             reversed: vec![false; n],
             last_impact_time: f64::NEG_INFINITY,
             impacts_at_this_instant: 0,
+            probe: EventProbe::default(),
+            start_forces: Vec::new(),
             steps: 0,
             evaluations: 0,
             ref_fn: Vec::new(),
