@@ -161,7 +161,7 @@ impl GroupSolver {
         self.work = 0;
         let per_step = contacts.len().max(1) as u64;
         // steps left to all attempts together under `max_work`
-        let mut left = policy.max_work.map_or(usize::MAX, |w| {
+        let left = policy.max_work.map_or(usize::MAX, |w| {
             usize::try_from(w / per_step).unwrap_or(usize::MAX)
         });
         let can_hold = !settings.e0_hold && contacts.iter().any(|c| c.material.restitution == 0.0);
@@ -170,6 +170,16 @@ impl GroupSolver {
         } else {
             policy.max_steps
         };
+        // an attempt stops at its step limit, checked before each step and
+        // each free flight, so it may end one step and two settlings of the
+        // modes (each at most 4 + 2 (points + patches) evaluations, patches
+        // ≤ points) beyond it: that much is kept back from the budget
+        let margin = if policy.max_work.is_some() {
+            2 + 2 * (4 + 4 * contacts.len()) / SETTLING_PER_STEP
+        } else {
+            0
+        };
+        let mut left = left.saturating_sub(margin);
         if left > 0 {
             let first = ImpactSettings {
                 max_steps: budget.min(settings.max_steps).min(left).max(1),
@@ -182,6 +192,7 @@ impl GroupSolver {
                 return result.map(|()| Resolution::Lzb);
             }
         }
+        left = left.saturating_sub(margin);
         if can_hold && left > 0 {
             let held = ImpactSettings {
                 e0_hold: true,

@@ -128,7 +128,9 @@ impl Integrator {
                     return Ok(StopReason::Released);
                 }
                 flights += 1;
-                if flights > self.layout.contacts + 2 {
+                if flights > self.layout.contacts + 2
+                    || attempts + self.settling / STAGES > max_steps
+                {
                     return Err(ImpactError::StepLimit { steps: out.steps });
                 }
                 self.settle();
