@@ -42,9 +42,11 @@ pub struct FallbackPolicy {
     pub held_retry_after: usize,
     /// Impulse steps of any single attempt at most (then the next stage).
     pub max_steps: usize,
-    /// Work of all LZB attempts of one impact together at most, in impulse
-    /// steps (accepted and rejected) times the impact's contact points (the
-    /// cost of a step grows with its contacts); an impact that would need
+    /// Work of all LZB attempts of one impact together at most, in steps
+    /// (accepted and rejected, and the time-domain resolver's settling of
+    /// modes counted as steps: [`ImpactOutcome::settling_evaluations`] / 6)
+    /// times the impact's contact points (the cost of a step grows with its
+    /// contacts); an impact that would need
     /// more is finished by the next stage, at the latest the plastic solve.
     /// `None` (default): no bound beyond `max_steps` per attempt. Engines use
     /// it as a frame budget: [`super::ImpactGroups::resolve`] lets the groups
@@ -111,6 +113,11 @@ pub fn gains_energy(out: &ImpactOutcome) -> bool {
     out.kinetic_energy_after > out.kinetic_energy_before * (1.0 + 1e-9) + f64::MIN_POSITIVE
 }
 
+/// Settling evaluations of the time-domain resolver that cost one of its
+/// steps (a Dormand–Prince step evaluates six stages; the resolver's step
+/// limit counts them the same way).
+const SETTLING_PER_STEP: usize = 6;
+
 fn unfinished(r: &Result<(), ImpactError>) -> bool {
     matches!(
         r,
@@ -136,8 +143,9 @@ impl GroupSolver {
         how
     }
 
-    /// Work of the LZB attempts of the last [`GroupSolver::solve_into`]: impulse
-    /// steps (accepted and rejected) times contact points.
+    /// Work of the LZB attempts of the last [`GroupSolver::solve_into`]: steps
+    /// (accepted and rejected, and settling evaluations / 6) times contact
+    /// points ([`FallbackPolicy::max_work`]).
     pub fn last_work(&self) -> u64 {
         self.work
     }
@@ -153,7 +161,7 @@ impl GroupSolver {
         self.work = 0;
         let per_step = contacts.len().max(1) as u64;
         // steps left to all attempts together under `max_work`
-        let mut left = policy.max_work.map_or(usize::MAX, |w| {
+        let left = policy.max_work.map_or(usize::MAX, |w| {
             usize::try_from(w / per_step).unwrap_or(usize::MAX)
         });
         let can_hold = !settings.e0_hold && contacts.iter().any(|c| c.material.restitution == 0.0);
@@ -162,6 +170,16 @@ impl GroupSolver {
         } else {
             policy.max_steps
         };
+        // an attempt stops at its step limit, checked before each step and
+        // each free flight, so it may end one step and two settlings of the
+        // modes (each at most 4 + 2 (points + patches) evaluations, patches
+        // ≤ points) beyond it: that much is kept back from the budget
+        let margin = if policy.max_work.is_some() {
+            2 + 2 * (4 + 4 * contacts.len()) / SETTLING_PER_STEP
+        } else {
+            0
+        };
+        let mut left = left.saturating_sub(margin);
         if left > 0 {
             let first = ImpactSettings {
                 max_steps: budget.min(settings.max_steps).min(left).max(1),
@@ -174,6 +192,7 @@ impl GroupSolver {
                 return result.map(|()| Resolution::Lzb);
             }
         }
+        left = left.saturating_sub(margin);
         if can_hold && left > 0 {
             let held = ImpactSettings {
                 e0_hold: true,
@@ -193,7 +212,7 @@ impl GroupSolver {
 
     /// Adds an attempt's steps to the work and takes them from `left`.
     fn charge(&mut self, out: &mut ImpactOutcome, per_step: u64, left: &mut usize) {
-        let steps = out.steps + out.rejected_steps;
+        let steps = out.steps + out.rejected_steps + out.settling_evaluations / SETTLING_PER_STEP;
         self.work += steps as u64 * per_step;
         *left = left.saturating_sub(steps);
     }
@@ -203,6 +222,7 @@ impl GroupSolver {
     fn fresh(out: &mut ImpactOutcome) {
         out.steps = 0;
         out.rejected_steps = 0;
+        out.settling_evaluations = 0;
     }
 }
 
@@ -297,6 +317,70 @@ mod tests {
             .unwrap();
         assert_ne!(how, Resolution::Plastic);
         assert!(solver.last_work() > 0);
+    }
+
+    /// An impact of the 150-box pile (17 boxes, 47 contact points, captured
+    /// from the Bevy frame bench) whose modes keep cycling at its switches:
+    /// each settling of the modes runs to its cap, so the resolver spends
+    /// most of its evaluations between steps.
+    fn cycling() -> crate::impact::capture::CapturedImpact {
+        serde_json::from_str(include_str!("../../tests/data/settling-cycle.json"))
+            .expect("the captured impact")
+    }
+
+    #[test]
+    fn settling_is_counted_as_work_and_bounded_by_the_budget() {
+        let cap = cycling();
+        let per_step = cap.contacts.len() as u64;
+        let mut out = ImpactOutcome::default();
+        let mut solver = GroupSolver::default();
+        // the resolver alone, with its own step limit: it spends more
+        // evaluations settling than its steps evaluate (six each)
+        let _ = ImpactSolver::new().solve_into(&cap.bodies, &cap.contacts, &cap.settings, &mut out);
+        let settling = out.settling_evaluations;
+        assert!(settling > 6 * (out.steps + out.rejected_steps), "{out:?}");
+        // with the fallback policy and no bound, the work charged includes
+        // the settling of the first attempt (the same solve)
+        solver
+            .solve_into(
+                &cap.bodies,
+                &cap.contacts,
+                &cap.settings,
+                &FallbackPolicy::default(),
+                &mut out,
+            )
+            .unwrap();
+        let unbounded = solver.last_work();
+        assert!(
+            unbounded >= (settling / SETTLING_PER_STEP) as u64 * per_step,
+            "{unbounded} {settling}"
+        );
+        assert!(!gains_energy(&out));
+        // a budget a tenth of that: the attempts stop at it, overshooting
+        // by at most the last settling before the check (its cap is
+        // 4 + 2 (points + patches) evaluations; patches ≤ points), then the
+        // plastic solve finishes the impact without creating energy
+        let budget = unbounded / 10;
+        let how = solver
+            .solve_into(
+                &cap.bodies,
+                &cap.contacts,
+                &cap.settings,
+                &FallbackPolicy {
+                    max_work: Some(budget),
+                    ..FallbackPolicy::default()
+                },
+                &mut out,
+            )
+            .unwrap();
+        let settle_cap = (4 + 4 * per_step) / SETTLING_PER_STEP as u64 + 1;
+        assert_eq!(how, Resolution::Plastic);
+        assert!(
+            solver.last_work() <= budget + 2 * settle_cap * per_step,
+            "{} {budget}",
+            solver.last_work()
+        );
+        assert!(out.kinetic_energy_after <= out.kinetic_energy_before);
     }
 
     #[test]

@@ -47,6 +47,14 @@ pub struct ImpactOutcome {
     pub steps: usize,
     /// Steps rejected by the adaptive error control.
     pub rejected_steps: usize,
+    /// Right-hand-side evaluations the time-domain resolver spent settling
+    /// the modes at the start and at each switch (0 for the impulse
+    /// stepping). A step of the time-domain resolver evaluates six stages,
+    /// so `settling_evaluations / 6` is the settling's cost in steps; the
+    /// step limit counts it (`ImpactSettings::max_steps`), and so does the
+    /// engines' work budget (`crate::coupling::FallbackPolicy::max_work`).
+    #[serde(default)]
+    pub settling_evaluations: usize,
     /// Why the resolver stopped.
     pub stop_reason: Option<StopReason>,
 }

@@ -108,6 +108,7 @@ impl ImpactSolver {
     ) -> Result<(), ImpactError> {
         validate::check(bodies, contacts, settings)?;
         capture::record(bodies, contacts, settings);
+        out.settling_evaluations = 0;
         match settings.step_control {
             // A lone contact: in the impulse its law is exact to rounding
             // (the velocities are linear in P and the energy's quadrature
@@ -278,6 +279,9 @@ pub(crate) struct Integrator {
     patch_states: Vec<PatchState>,
     constraints: Constraints,
     constraints_dirty: bool,
+    /// Right-hand-side evaluations spent settling modes in this impact
+    /// ([`ImpactOutcome::settling_evaluations`]).
+    settling: usize,
     // probe and events
     suspects: Vec<Suspect>,
     generation: u32,
@@ -318,8 +322,10 @@ impl Integrator {
         out.kinetic_energy_before = bodies.iter().map(Body::kinetic_energy).sum();
         out.steps = 0;
         out.rejected_steps = 0;
-        let reason = self.run(settings.max_steps, out)?;
-        self.finish(bodies, reason, out);
+        self.settling = 0;
+        let reason = self.run(settings.max_steps, out);
+        out.settling_evaluations = self.settling;
+        self.finish(bodies, reason?, out);
         Ok(())
     }
 

@@ -33,6 +33,7 @@ impl Integrator {
         let cap = 4 + 2 * (self.rows.len() + self.patches.len());
         let mut slope = std::mem::take(&mut self.probe_slope);
         for _ in 0..cap {
+            self.settling += 1;
             self.refresh_constraints();
             let y = std::mem::take(&mut self.y);
             self.eval(&y, &mut slope, false);

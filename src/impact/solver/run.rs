@@ -70,6 +70,10 @@ const ONSET_STEP: f64 = 0.3;
 /// (see `standstill` in the loop).
 const CRAWL: f64 = 1e-5;
 
+/// Right-hand-side evaluations of one step (Dormand–Prince, first same as
+/// last): the step limit counts this many settling evaluations as a step.
+const STAGES: usize = 6;
+
 /// A root segment goes on in time once x is this many steps past the onset
 /// (the t^α start is resolved by then).
 const ROOT_SPAN: f64 = 3.0;
@@ -124,7 +128,9 @@ impl Integrator {
                     return Ok(StopReason::Released);
                 }
                 flights += 1;
-                if flights > self.layout.contacts + 2 {
+                if flights > self.layout.contacts + 2
+                    || attempts + self.settling / STAGES > max_steps
+                {
                     return Err(ImpactError::StepLimit { steps: out.steps });
                 }
                 self.settle();
@@ -132,7 +138,9 @@ impl Integrator {
                 continue;
             }
             attempts += 1;
-            if attempts > max_steps {
+            // settling the modes at switches costs evaluations too; a set of
+            // modes that keeps cycling would otherwise spend them unbounded
+            if attempts + self.settling / STAGES > max_steps {
                 return Err(ImpactError::StepLimit { steps: out.steps });
             }
             if let Variable::End { sigma, .. } = self.clock.variable {
