@@ -289,6 +289,8 @@ pub(crate) struct Integrator {
     /// Held points and stuck patches watched by the present search, with
     /// the sign of each patch's friction.
     watched: Vec<(Suspect, f64)>,
+    /// Digests of the modes met by the present settling (modes.rs).
+    seen_modes: Vec<u64>,
     // scratch
     rk: rk::Rk,
     order: Vec<usize>,

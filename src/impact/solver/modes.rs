@@ -29,9 +29,18 @@ use super::{Integrator, PatchMode, PointMode};
 
 impl Integrator {
     /// Settles every mode at the present state.
+    ///
+    /// Each pass re-evaluates the forces with the modes of the last and
+    /// changes every mode whose condition fails. The passes end when nothing
+    /// changes, or when a pass comes back to modes and velocities already
+    /// seen in this settling: from there the passes would repeat the same
+    /// cycle to the cap (a stuck patch at its bound breaks loose and the
+    /// rows around it turn it back to sticking), so the cycle is left as it
+    /// is and the next event resolves it, as the cap would leave it.
     pub(super) fn settle(&mut self) {
         let cap = 4 + 2 * (self.rows.len() + self.patches.len());
         let mut slope = std::mem::take(&mut self.probe_slope);
+        self.seen_modes.clear();
         for _ in 0..cap {
             self.settling += 1;
             self.refresh_constraints();
@@ -43,9 +52,38 @@ impl Integrator {
             if !changed {
                 break;
             }
+            let signature = self.mode_signature();
+            if self.seen_modes.contains(&signature) {
+                break;
+            }
+            self.seen_modes.push(signature);
         }
         self.refresh_constraints();
         self.probe_slope = slope;
+    }
+
+    /// A 64-bit digest (FNV-1a) of every point's and patch's mode and of
+    /// the body velocities: equal digests within one settling mean the
+    /// passes have come back to a state they left (a collision only ends
+    /// the passes early, as the cap would).
+    fn mode_signature(&self) -> u64 {
+        const PRIME: u64 = 0x0000_0100_0000_01b3;
+        let mut h: u64 = 0xcbf2_9ce4_8422_2325;
+        let mut add = |x: u64| h = (h ^ x).wrapping_mul(PRIME);
+        for point in &self.points {
+            add(point.mode as u64);
+        }
+        for mode in &self.patch_modes {
+            add(match *mode {
+                PatchMode::Idle => 0,
+                PatchMode::Stick => 1,
+                PatchMode::Slide(s) => 2 + u64::from(s > 0.0),
+            });
+        }
+        for v in &self.y[..3 * self.layout.bodies] {
+            add(v.to_bits());
+        }
+        h
     }
 
     fn settle_points(&mut self, slope: &[f64]) -> bool {
