@@ -96,7 +96,10 @@ pub struct ImpactSettings {
     /// fast_cycle · v), its next cycles are taken by their limit — held
     /// closed by a non-negative force that keeps its rate — until that force
     /// would pull. The limit differs from the cycles by terms of the order
-    /// of the cycle's swing W_ii ΔP (docs/model.md §8). 0: every cycle is
+    /// of the cycle's swing W_ii ΔP (docs/model.md §8). e > 0 contacts that
+    /// bounce again and again inside a pile are held the same way after a
+    /// cycle within 0.03 of this bound, their small approach stopped as
+    /// by a plastic impact (§8, "Fast bounces at e > 0"). 0: every cycle is
     /// followed (the paper's law to the integration tolerance).
     #[serde(default = "default_fast_cycle")]
     pub fast_cycle: f64,

@@ -40,6 +40,9 @@ pub(super) enum Switch {
     Closes(usize),
     /// A sliding patch's slip reaches zero.
     SlipStops(usize),
+    /// The hold of an e > 0 point has taken one fast cycle's swing: the
+    /// point loads under the law from here (docs/model.md §8).
+    HoldSpent(usize),
 }
 
 /// Switches closer than this fraction of a step to the earliest one are
@@ -161,6 +164,13 @@ impl Integrator {
                         out[0] = Some(Watch::one(Switch::Recompresses(i), (rate, -1.0, thr)));
                         out[1] = Some(Watch::one(Switch::LetsGo(i), (q, -1.0, row.q_zero)));
                     }
+                    PointMode::Held if point.hold_limit.is_finite() => {
+                        let pn = rk.dense_functional(&[(self.layout.pn(i), 1.0)]);
+                        out[0] = Some(Watch::one(
+                            Switch::HoldSpent(i),
+                            (pn, 1.0, point.hold_limit),
+                        ));
+                    }
                     PointMode::Held => {}
                 }
             }
@@ -229,7 +239,8 @@ impl Integrator {
             Switch::CompressionEnds(i)
             | Switch::Recompresses(i)
             | Switch::LetsGo(i)
-            | Switch::Closes(i) => self.points[i].switched_at = now,
+            | Switch::Closes(i)
+            | Switch::HoldSpent(i) => self.points[i].switched_at = now,
         }
         match switch {
             Switch::CompressionEnds(i) => {
@@ -250,12 +261,23 @@ impl Integrator {
             }
             Switch::Recompresses(i) => self.points[i].mode = PointMode::Compress,
             Switch::LetsGo(i) => {
+                self.end_cycle(i);
                 self.points[i].mode = PointMode::Compress;
                 self.y[lay.q(i)] = 0.0;
             }
             // the segment restarts at the onset (see `Variable::Root`); a
             // patch without slip sticks from here (modes.rs)
-            Switch::Closes(_) => {}
+            Switch::Closes(i) => self.closes_after_cycle(i),
+            Switch::HoldSpent(i) => {
+                // on from rest, touching, under the law (no stored energy)
+                let point = &mut self.points[i];
+                point.mode = PointMode::Compress;
+                point.hold_limit = f64::INFINITY;
+                point.fast_rebound = false;
+                point.cycle_start = self.y[lay.pn(i)];
+                self.y[lay.q(i)] = 0.0;
+                self.constraints_dirty = true;
+            }
             Switch::SlipStops(p) => self.set_patch(p, PatchMode::Stick),
         }
     }

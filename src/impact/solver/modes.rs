@@ -88,9 +88,13 @@ impl Integrator {
 
     fn settle_points(&mut self, slope: &[f64]) -> bool {
         let thr = self.scales.rate;
+        // the largest approach a closing after a fast cycle may have to be
+        // held (docs/model.md §8); e = 0 points are at rest to rounding
+        let slow = (2.0 * thr).max(self.fast_bounce * self.scales.velocity);
         let lay = self.layout;
         let now = self.y[lay.time()];
         let mut changed = false;
+        let mut plastic = false;
         for i in 0..lay.contacts {
             let row = &self.rows[i];
             if !row.movable {
@@ -99,28 +103,71 @@ impl Integrator {
             let point = &mut self.points[i];
             match point.mode {
                 PointMode::Compress if point.released => {
-                    // an e = 0 point whose fast load cycle just ended: held
-                    // if it is pushed in again
+                    // an e = 0 point whose fast load cycle just ended, or an
+                    // e > 0 point closing after one: held if it is pushed in
+                    // again (an approach of the latter is stopped by the
+                    // hold, as a plastic impact would stop it)
                     let rate = normal_rate(row, &self.y);
-                    if rate <= 2.0 * thr && normal_rate(row, slope) < 0.0 {
+                    if rate <= 2.0 * thr && -rate <= slow && normal_rate(row, slope) < 0.0 {
                         point.mode = PointMode::Held;
+                        point.hold_limit = if row.law.restitution > 0.0 {
+                            // P_n after the plastic stop, plus one fast swing
+                            self.y[lay.pn(i)]
+                                + (-rate).max(0.0) / row.w_nn
+                                + self.fast_bounce * self.scales.velocity / row.w_nn
+                        } else {
+                            f64::INFINITY
+                        };
                         point.switched_at = now;
                         self.constraints_dirty = true;
                         changed = true;
+                        plastic |= rate < -2.0 * thr;
                     }
                     point.released = false;
                 }
                 PointMode::Held if point.held_force <= 0.0 => {
+                    // a hold that lets go at the instant it was made took
+                    // nothing: the point's next closing follows the law
+                    let lasted = point.switched_at < now;
+                    point.fast_rebound = false;
+                    point.hold_limit = f64::INFINITY;
                     point.mode = PointMode::Compress;
                     point.switched_at = now;
                     self.y[lay.q(i)] = 0.0;
                     self.constraints_dirty = true;
                     changed = true;
+                    if lasted && row.law.restitution > 0.0 {
+                        self.end_cycle(i);
+                    }
                 }
                 _ => {}
             }
         }
+        if plastic {
+            self.stop_slips();
+        }
         changed
+    }
+
+    /// Ends point `i`'s load cycle (an e > 0 point lets go, or its hold
+    /// ends): a cycle that moved its own rate by at most `fast_cycle` of the
+    /// velocity scale, W_ii ΔP ≤ fast_cycle · V, makes its next closing a
+    /// candidate for the hold (docs/model.md §8).
+    pub(super) fn end_cycle(&mut self, i: usize) {
+        let pn = self.y[self.layout.pn(i)];
+        let swing = self.rows[i].w_nn * (pn - self.points[i].cycle_start);
+        let point = &mut self.points[i];
+        point.cycle_start = pn;
+        point.fast_rebound = swing <= self.fast_bounce * self.scales.velocity;
+    }
+
+    /// Point `i`'s gap has closed: after a fast cycle of an e > 0 point the
+    /// next settling holds it if it is pushed in.
+    pub(super) fn closes_after_cycle(&mut self, i: usize) {
+        let point = &mut self.points[i];
+        if point.fast_rebound && self.rows[i].law.restitution > 0.0 {
+            point.released = true;
+        }
     }
 
     /// Whether a point carries load or is about to: compressed, held, or

@@ -138,7 +138,7 @@ impl Integrator {
                 row.slide * normal
             };
             if probe {
-                self.probe_point(i, y[lay.q(i)], rate);
+                self.probe_point(i, y[lay.q(i)], rate, y[lay.pn(i)]);
             }
         }
         if probe {
@@ -176,7 +176,7 @@ impl Integrator {
     /// Notes a point whose mode's condition fails at a trial point (see
     /// events.rs).
     #[inline]
-    fn probe_point(&mut self, i: usize, q: f64, rate: f64) {
+    fn probe_point(&mut self, i: usize, q: f64, rate: f64, pn: f64) {
         let thr = self.scales.rate;
         let point = &self.points[i];
         let row = &self.rows[i];
@@ -188,7 +188,7 @@ impl Integrator {
                         && (rate < -self.scales.onset || self.onset_matters(i)))
             }
             PointMode::Expand => rate < -thr || q < -row.q_zero,
-            PointMode::Held => point.held_force < 0.0,
+            PointMode::Held => point.held_force < 0.0 || pn > point.hold_limit,
         };
         if fails {
             self.suspect_point(i);

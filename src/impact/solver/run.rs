@@ -350,11 +350,14 @@ impl Integrator {
         let lay = self.layout;
         self.y[lay.q(point)] = 0.0;
         self.points[point].mode = PointMode::Compress;
-        for (i, row) in self.rows.iter().enumerate() {
-            let q = &mut self.y[lay.q(i)];
-            if self.points[i].mode == PointMode::Expand && *q <= 1e-9 * row.q_scale {
-                *q = 0.0;
+        self.end_cycle(point);
+        for i in 0..lay.contacts {
+            let spent = self.points[i].mode == PointMode::Expand
+                && self.y[lay.q(i)] <= 1e-9 * self.rows[i].q_scale;
+            if spent {
+                self.y[lay.q(i)] = 0.0;
                 self.points[i].mode = PointMode::Compress;
+                self.end_cycle(i);
             }
         }
     }
@@ -394,6 +397,7 @@ impl Integrator {
         }
         self.y[lay.q(first)] = 0.0;
         self.y[lay.time()] += shortest;
+        self.closes_after_cycle(first);
         true
     }
 
