@@ -21,7 +21,7 @@
 //!   `cradle-5` (assets/scenes/cradle-5.toml).
 //!
 //! Without an ODE, the converged answer is the time-domain solver at
-//! tolerance 10⁻¹⁰ with every e = 0 cycle followed (`fast_cycle = 0`); the
+//! tolerance 10⁻¹⁰ with every fast cycle followed (`fast_cycle = 0`); the
 //! `check` column gives its distance from the adaptive impulse stepping at
 //! 10⁻⁶, a second way to the same answer (its own error is of that order). Errors are the largest velocity
 //! difference of any body (ω through its radius of gyration) over the
