@@ -14,5 +14,6 @@ mod shapes;
 mod sleeping;
 mod soak;
 mod stress_checks;
+mod substeps;
 mod vs_reference;
 mod warm_start;

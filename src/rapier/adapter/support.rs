@@ -127,17 +127,11 @@ pub(crate) fn role(rb: &RigidBody) -> Role {
     }
 }
 
-/// The role of a collider's body (a collider without a body is a wall).
-pub(crate) fn collider_role(bodies: &RigidBodySet, co: &Collider) -> Role {
-    match co.parent().and_then(|h| bodies.get(h)) {
-        Some(rb) => role(rb),
-        None => Role::Wall,
-    }
-}
-
 /// Whether topple resolves the impacts of two managed colliders: `Ok` with
 /// the way to read their geometry, or the collider (of the two) topple
-/// leaves to Rapier and why. Two walls are never an impact pair.
+/// leaves to Rapier and why. Two walls are never an impact pair. The hook
+/// asks this of every managed pair at every Rapier step, so each collider
+/// and body is looked up once.
 pub(crate) fn pair(
     bodies: &RigidBodySet,
     colliders: &ColliderSet,
@@ -169,7 +163,10 @@ pub(crate) fn pair(
             Err(reason) => return notice(h, co, reason),
         }
     }
-    let (ra, rb) = (collider_role(bodies, ca), collider_role(bodies, cb));
+    let body = |co: &Collider| co.parent().and_then(|h| bodies.get(h));
+    let (ba, bb) = (body(ca), body(cb));
+    // a collider without a body is a wall
+    let (ra, rb) = (ba.map_or(Role::Wall, role), bb.map_or(Role::Wall, role));
     for (h, co, r) in [(a, ca, ra), (b, cb, rb)] {
         if let Role::Left(reason) = r {
             return notice(h, co, reason);
@@ -178,12 +175,8 @@ pub(crate) fn pair(
     match (ra, rb) {
         (Role::Wall, Role::Wall) => return Err(None),
         (Role::Free, Role::Free) => {
-            let group = |co: &Collider| {
-                co.parent()
-                    .and_then(|h| bodies.get(h))
-                    .map_or(0, RigidBody::dominance_group)
-            };
-            if group(ca) != group(cb) {
+            let group = |b: Option<&RigidBody>| b.map_or(0, RigidBody::dominance_group);
+            if group(ba) != group(bb) {
                 return notice(a, ca, LeftToRapier::Dominance);
             }
         }

@@ -39,10 +39,11 @@ impl ImpactPass {
         let tol = closed_tolerance(settings);
         let far = 1e3 * world.prediction.max(tol) + world.length_unit;
         let search = Search { k, tol, far };
-        if self.gap_at(world, &search, dt) > tol {
+        let end = self.gap_at(world, &search, dt);
+        if end > tol {
             return f64::INFINITY;
         }
-        match self.bracket(world, &search, t0) {
+        match self.bracket(world, &search, t0, end) {
             Ok(closed) => closed,
             Err(bracket) => self.narrow(world, &search, bracket),
         }
@@ -57,15 +58,22 @@ impl ImpactPass {
     /// Samples the gap at the segment start and at a quarter, half and
     /// three quarters of the rest of the step: `Ok(t0)` if it is closed at
     /// the start, else the bracket `(a, g(a), b, g(b))` of the first
-    /// closing (the end of the step closes, the caller checked).
-    fn bracket(&mut self, world: &World, search: &Search, t0: f64) -> Result<f64, [f64; 4]> {
+    /// closing (the end of the step closes with gap `end` (m), the caller
+    /// checked).
+    fn bracket(
+        &mut self,
+        world: &World,
+        search: &Search,
+        t0: f64,
+        end: f64,
+    ) -> Result<f64, [f64; 4]> {
         let dt = self.motion.dt;
         let (mut a, mut ga) = (t0, self.gap_at(world, search, t0));
         if ga <= search.tol {
             return Ok(t0);
         }
         let mut b = dt;
-        let mut gb = self.gap_at(world, search, dt);
+        let mut gb = end;
         for j in 1..4 {
             let t = t0 + (dt - t0) * j as f64 / 4.0;
             let g = self.gap_at(world, search, t);
