@@ -12,12 +12,15 @@
 # unpacked .crate's path) runs `cargo tree`. The Bevy line must pull in one
 # Rapier build (rapier2d, not rapier2d-f64) and no command-line crate.
 # Resolving uses the registry index already fetched (`--offline`).
+# `--no-verify`: skip the verify step (.ci/lib_alone.sh builds and tests the
+# unpacked .crate instead, which compiles the same sources).
 set -euo pipefail
+verify=(); [ "${1:-}" = "--no-verify" ] && verify=(--no-verify)
 cd "$(dirname "$0")/.."
 TARGET_DIR=${TARGET_DIR:-$(.ci/target_dir.sh)}
 
 version=$(sed -n 's/^version = "\(.*\)"/\1/p' Cargo.toml | head -1)
-cargo package --locked --no-default-features --allow-dirty --quiet
+cargo package --locked --no-default-features --allow-dirty --quiet "${verify[@]}"
 crate="$TARGET_DIR/package/topple-$version.crate"
 [ -s "$crate" ] || { echo "no $crate after cargo package"; exit 1; }
 size=$(stat -c %s "$crate")

@@ -1,13 +1,15 @@
 #!/usr/bin/env bash
 # The checks of the library built without default features, in a target
 # directory of their own (argument 1, else lib-alone/ in cargo's target dir):
-# `cargo package` verified and the dependency lines of README.md and
-# docs/bevy.md; clippy on the library alone with each feature set that
-# picks code; the unit tests without default features. They share no
-# compiled unit with the tests' build (other features of serde, clap, glam,
-# nalgebra …, check builds, the dev profile), so .ci/run starts them beside
-# the tests' run, the stress sweep and the Bevy stage, which leave part of
-# the two cores idle. Runs alone as well: `.ci/lib_alone.sh [target dir]`.
+# `cargo package` and the dependency lines of README.md and docs/bevy.md;
+# the packaged sources built and their unit tests run without default
+# features; clippy on the library alone with each feature set that picks
+# code. They share no compiled unit with the tests' build (other features
+# of serde, clap, glam, nalgebra …, check builds, the dev profile), so
+# .ci/run starts them at the lowest CPU priority (`nice -n 19`) beside its
+# own stages: they take the cores when the build, the tests' run and the
+# Bevy stage leave one idle. Runs alone as well: `.ci/lib_alone.sh [target
+# dir]`.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 STAGE_PREFIX="[lib-alone] "
@@ -18,9 +20,31 @@ export TARGET_DIR CARGO_TARGET_DIR="$TARGET_DIR"
 # plain rustc and cargo clippy here: the wrapper of .ci/run is for the
 # tests' build
 unset RUSTC_WORKSPACE_WRAPPER CLIPPY_ARGS
+# The dev profile's builds below without debug information and without
+# incremental compilation: neither changes the code nor its checks (debug
+# assertions and overflow checks stay on), both cost CPU in a cold build
+# that is thrown away (docs/ci.md).
+export CARGO_PROFILE_DEV_DEBUG=0 CARGO_INCREMENTAL=0
 
-stage "cargo package (verified without default features); the dependency lines of README.md and docs/bevy.md resolve"
-.ci/check_dependency_lines.sh
+stage "cargo package (without default features); the dependency lines of README.md and docs/bevy.md resolve"
+# `--no-verify`: the packaged sources are built and tested below, which is
+# what cargo's verify step would build (the library, dev profile) and more
+.ci/check_dependency_lines.sh --no-verify
+version=$(sed -n 's/^version = "\(.*\)"/\1/p' Cargo.toml | head -1)
+unpacked=$(mktemp -d)
+trap 'rm -rf "$unpacked"; rm -f "$stage_cpu_file"' EXIT
+tar xzf "$TARGET_DIR/package/topple-$version.crate" -C "$unpacked"
+
+# The unit tests pass without Rapier and rayon (runs refused with
+# SceneError::NotBuilt, the sweeps in turn), built from the packaged .crate
+# (so the package is known to build: cargo package's verify step). In the
+# dev profile (debug assertions and overflow checks on): this feature set's
+# serde, clap, criterion and proptest differ in features from the full
+# build's, so they are compiled again either way, and unoptimised that
+# takes two thirds of the CPU (docs/ci.md).
+stage "the packaged crate builds; its unit tests without default features (cargo test --profile dev --lib)"
+cargo test --locked --profile dev --lib --no-default-features \
+    --manifest-path "$unpacked/topple-$version/Cargo.toml"
 
 # Each feature that picks code builds and lints alone (cargo hack is not
 # installed here: an explicit list; `cli`, `plots`, `scene-files` are covered
@@ -34,12 +58,4 @@ for set in "" "f32" "f64"; do
     stage "cargo clippy --lib --no-default-features --features '$set'"
     cargo clippy --locked --release --lib --no-default-features --features "$set" -- -D warnings
 done
-# ...and the unit tests pass without Rapier and rayon (runs refused with
-# SceneError::NotBuilt, the sweeps in turn). In the dev profile (debug
-# assertions and overflow checks on): this feature set's serde, clap,
-# criterion and proptest differ in features from the full build's, so they
-# are compiled again either way, and unoptimised that takes two thirds of
-# the CPU (docs/ci.md).
-stage "cargo test --profile dev --lib --no-default-features"
-cargo test --locked --profile dev --lib --no-default-features
 stage "done"
