@@ -27,12 +27,7 @@ pub fn run_jobs(jobs: &[Job], store: &RunStore, resume: bool) -> Results {
     let next = AtomicUsize::new(0);
     let done: Mutex<Vec<Option<Result<ChainReport, String>>>> =
         Mutex::new(jobs.iter().map(|_| None).collect());
-    // every worker takes the next job of the list until none is left, so
-    // both cores stay busy to the end and the last to start are the shortest
-    let worker = || loop {
-        let Some(&k) = order.get(next.fetch_add(1, Ordering::Relaxed)) else {
-            break;
-        };
+    let run_one = |k: usize| {
         let j = &jobs[k];
         let r = match resume.then(|| store.load(&j.row, &j.settings)).flatten() {
             Some(saved) => {
@@ -44,6 +39,13 @@ pub fn run_jobs(jobs: &[Job], store: &RunStore, resume: bool) -> Results {
         bar.inc(1);
         if let Ok(mut d) = done.lock() {
             d[k] = Some(r);
+        }
+    };
+    // every worker takes the next job of the list until none is left, so
+    // both cores stay busy to the end and the last to start are the shortest
+    let worker = || {
+        while let Some(&k) = order.get(next.fetch_add(1, Ordering::Relaxed)) {
+            run_one(k);
         }
     };
     rayon::scope(|s| {
@@ -72,8 +74,8 @@ pub fn run_jobs(jobs: &[Job], store: &RunStore, resume: bool) -> Results {
 /// The jobs' indices, the most expensive first ([`expected_cost`]): with
 /// one worker per core taking the next job as it becomes free, the long
 /// rows start at once and the run ends on short ones, not on a long row
-/// left to one core at the end (longest processing time first, within
-/// 4/3 of the best possible end for any list of run times).
+/// left to one core at the end (the longest-processing-time-first rule,
+/// on estimated times).
 fn longest_first(jobs: &[Job]) -> Vec<usize> {
     let mut order: Vec<usize> = (0..jobs.len()).collect();
     order.sort_by(|&a, &b| expected_cost(&jobs[b]).total_cmp(&expected_cost(&jobs[a])));
@@ -84,9 +86,9 @@ fn longest_first(jobs: &[Job]) -> Vec<usize> {
 /// of the row, times 3 for rows whose blocks both bounce and rub on each
 /// other (e1 > 0 and μ1 > 0: the Table 1 rows, whose chatter makes most of
 /// the impacts), over the spacing ratio (a close row keeps more blocks in
-/// each impact and in the moving window), floored at 0.1. Measured on a
-/// full `topple paper` run, this order ends within a second of the best
-/// order of the measured run times.
+/// each impact and in the moving window), floored at 0.1. On the run
+/// times of a full `topple paper` run, this order ends within 0.1 % of the
+/// best list order of those times (docs/reference-performance.md).
 fn expected_cost(j: &Job) -> f64 {
     let p = &j.row.params;
     let bouncing = if p.e1 > 0.0 && p.mu1 > 0.0 { 3.0 } else { 1.0 };

@@ -169,7 +169,8 @@ impl GapBounds {
             Some(f) => {
                 let qf = view.q(f);
                 let rho = (g.point[0] - qf[0]).hypot(g.point[1] - qf[1]);
-                if !(rho + g.gap <= self.lever) {
+                let within = rho + g.gap <= self.lever;
+                if !within {
                     self.records[k] = None;
                     return;
                 }
