@@ -76,14 +76,28 @@ impl Engine {
         let is_active = &self.is_active;
         let eps = self.eps_gap;
         let vapp = self.v_app;
+        // a slot whose gap bound clears zero has no part in the scan
+        // (`scan.rs`); the others are measured and their bounds renewed
+        let mut bounds = std::mem::take(&mut self.gap_bounds);
+        bounds.start(self.lo, self.hi, &self.y, y1);
         self.for_each_slot(&view, |i, slot| {
             let watched_slot = watch_slot == Some((i, slot));
             if is_active.contains(i, slot) || (event && !watched_slot) {
                 return;
             }
+            let kept = bounds.index(i, slot);
+            if let Some(k) = kept
+                && !watched_slot
+                && bounds.clear(k)
+            {
+                return;
+            }
             let Some(g) = rc.geom(&view, i, slot) else {
                 return;
             };
+            if let Some(k) = kept {
+                bounds.keep(k, &g, &view);
+            }
             if !g.valid {
                 return;
             }
@@ -110,12 +124,20 @@ impl Engine {
         // penetration covers every corner the row can drive into a neighbour.
         let lambda = self.rc.p.lambda_points;
         for i in self.lo.saturating_sub(1)..self.hi.min(self.row.n.saturating_sub(2)) {
-            if let Some(g) = rc.geom(&view, i, lambda + 2)
-                && g.valid
-            {
-                deepest = deepest.min(g.gap);
+            let kept = bounds.index(i, lambda + 2);
+            if kept.is_some_and(|k| bounds.clear(k)) {
+                continue;
+            }
+            if let Some(g) = rc.geom(&view, i, lambda + 2) {
+                if let Some(k) = kept {
+                    bounds.keep(k, &g, &view);
+                }
+                if g.valid {
+                    deepest = deepest.min(g.gap);
+                }
             }
         }
+        self.gap_bounds = bounds;
         self.max_penetration = self.max_penetration.max(-deepest);
         event
     }

@@ -16,6 +16,7 @@
 //! | `impacts.rs` | one impact: the approaching contacts, the group they start, the LZB solve through [`crate::coupling::GroupSolver`] |
 //! | `active.rs` | the active set: the mode search among closed contacts and the projection onto the active constraints |
 //! | `window.rs` | the moving blocks lo..hi: their state vector, the candidate slots, waking and freezing |
+//! | `scan.rs` | lower bounds on the candidates' gaps, so that the event scan measures only those that can have closed |
 //! | `record.rs` | hits, rebounds, series, snapshots and the final report |
 //!
 //! The stage files import from this file and the leaf modules of
@@ -39,6 +40,7 @@ mod events;
 mod impacts;
 mod integrate;
 mod record;
+mod scan;
 mod window;
 
 /// Why a run failed.
@@ -229,6 +231,8 @@ struct Engine {
     last_impact_time: f64,
     impacts_at_this_instant: usize,
     probe: EventProbe,
+    /// Bounds on the gaps of the window's candidate slots (`scan.rs`).
+    gap_bounds: scan::GapBounds,
     /// F_n, F_t (N) and v_t (m/s) of each active contact at the step start
     /// (`eval_k0`): the event margins there, for the event location.
     start_forces: Vec<[f64; 3]>,
@@ -309,6 +313,7 @@ impl Engine {
             last_impact_time: f64::NEG_INFINITY,
             impacts_at_this_instant: 0,
             probe: EventProbe::default(),
+            gap_bounds: scan::GapBounds::new(k_slots, p.block.height, p.block.thickness),
             start_forces: Vec::new(),
             steps: 0,
             evaluations: 0,
