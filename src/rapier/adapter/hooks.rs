@@ -210,7 +210,26 @@ impl ToppleHooks {
         if context.manifold.points.iter().any(|p| p.data.impulse > 0.0) {
             *context.user_data = self.frame;
         }
-        let threshold = self.threshold_of(*context.user_data, pair.impact.restitution) as Real;
+        let support = if self.stand_aside {
+            Err(None)
+        } else {
+            support::pair(
+                context.bodies,
+                context.colliders,
+                context.collider1,
+                context.collider2,
+            )
+        };
+        // a composite shape keeps the frame's threshold: parry can miss a
+        // sub-shape's points at the gaps where the pass resolves an impact
+        // (a flat face across a polyline's vertex), and a slow approach the
+        // pass cannot resolve must stay Rapier's
+        let threshold = match support {
+            Ok(support::Geometry::Convex) => {
+                self.threshold_of(*context.user_data, pair.impact.restitution)
+            }
+            _ => self.min_approach_speed,
+        } as Real;
         // Rapier's own notion of a lasting contact: the point carried an
         // impulse in Rapier's last step and touches. Its approach in
         // discrete time (of order g·Δt and v_t·ω·Δt on a sliding or
@@ -222,16 +241,6 @@ impl ToppleHooks {
             let lasting = c.contact_id[0] & NEW_CONTACT_BIT == 0 && c.dist <= 0.0;
             let vn = (velocity(b2, c.anchor2) - velocity(b1, c.anchor1)).dot(n);
             lasting || vn >= -threshold
-        };
-        let support = if self.stand_aside {
-            Err(None)
-        } else {
-            support::pair(
-                context.bodies,
-                context.colliders,
-                context.collider1,
-                context.collider2,
-            )
         };
         if let Err(notice) = support {
             // Rapier's, as native Rapier

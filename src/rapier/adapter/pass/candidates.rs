@@ -113,7 +113,11 @@ impl ImpactPass {
             key,
             toi: f64::INFINITY,
             done: false,
-            threshold: pair_threshold(world, hooks, a, b),
+            threshold: match geometry {
+                // as the hook: composite shapes keep the frame's threshold
+                support::Geometry::Convex => pair_threshold(world, hooks, a, b),
+                support::Geometry::Composite => hooks.min_approach_speed,
+            },
         });
     }
 
