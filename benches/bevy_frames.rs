@@ -19,7 +19,10 @@
 //! and how many frames took longer than 1/60 s, topple's share, and what topple did (impacts, fallbacks, steps whose
 //! work budget ran out, pairs left to Rapier), and per scene whether any
 //! body's state became NaN and how far the lowest body reached below the
-//! ground's top face.
+//! ground's top face. A second table gives the CPU time of the process per
+//! frame (`CLOCK_PROCESS_CPUTIME_ID`, all of Bevy's threads), mean and
+//! worst, for both engines: on a loaded machine wall-clock frames stretch
+//! with the load, CPU time much less.
 
 #[path = "../examples/common/scenes.rs"]
 mod scenes;
@@ -38,6 +41,9 @@ mod show;
 struct Run {
     mean_ms: f64,
     worst_ms: f64,
+    /// CPU time of the process per frame, mean and worst (ms).
+    cpu_mean_ms: f64,
+    cpu_worst_ms: f64,
     /// Frames longer than 1/60 s.
     slow: usize,
     topple_ms: f64,
@@ -55,6 +61,8 @@ fn measure(app: &mut App, frames: usize, ground_y: f32) -> Run {
     let mut run = Run {
         mean_ms: 0.0,
         worst_ms: 0.0,
+        cpu_mean_ms: 0.0,
+        cpu_worst_ms: 0.0,
         slow: 0,
         topple_ms: 0.0,
         impacts: 0,
@@ -65,10 +73,13 @@ fn measure(app: &mut App, frames: usize, ground_y: f32) -> Run {
         below_ground: 0.0,
     };
     let start = Instant::now();
+    let cpu_start = process_cpu_ms();
     for frame in 0..frames {
         let t = Instant::now();
+        let cpu = process_cpu_ms();
         app.update();
         let ms = 1e3 * t.elapsed().as_secs_f64();
+        run.cpu_worst_ms = run.cpu_worst_ms.max(process_cpu_ms() - cpu);
         if std::env::var("FRAMES_VERBOSE").is_ok() {
             let s = app.world().resource::<ToppleFrameStats>();
             eprintln!(
@@ -86,6 +97,7 @@ fn measure(app: &mut App, frames: usize, ground_y: f32) -> Run {
         run.native_impacts += s.native_impacts;
     }
     run.mean_ms = 1e3 * start.elapsed().as_secs_f64() / frames as f64;
+    run.cpu_mean_ms = (process_cpu_ms() - cpu_start) / frames as f64;
     run.topple_ms /= frames as f64;
     let world = app.world_mut();
     let mut q = world.query_filtered::<(&Transform, &Velocity, &Collider), With<RigidBody>>();
@@ -98,6 +110,29 @@ fn measure(app: &mut App, frames: usize, ground_y: f32) -> Run {
         run.below_ground = run.below_ground.max(ground_y - aabb.mins.y);
     }
     run
+}
+
+/// CPU time the process has used (ms), every thread's (NaN where there
+/// is no such clock).
+#[cfg(not(unix))]
+fn process_cpu_ms() -> f64 {
+    f64::NAN
+}
+
+/// CPU time the process has used (ms), every thread's.
+#[cfg(unix)]
+fn process_cpu_ms() -> f64 {
+    let mut ts = libc::timespec {
+        tv_sec: 0,
+        tv_nsec: 0,
+    };
+    // SAFETY: `ts` is a valid timespec for the call to write.
+    let ok = unsafe { libc::clock_gettime(libc::CLOCK_PROCESS_CPUTIME_ID, &mut ts) } == 0;
+    if ok {
+        ts.tv_sec as f64 * 1e3 + ts.tv_nsec as f64 * 1e-6
+    } else {
+        f64::NAN
+    }
 }
 
 /// The value of `--NAME=VALUE` on the command line, if given. Flags:
@@ -160,7 +195,22 @@ fn row(physics: ImpactResponse, n: usize, frames: usize) -> Run {
     measure(&mut app, frames, 0.0)
 }
 
+/// The CPU-time rows, printed after the wall-clock table.
+static CPU_ROWS: std::sync::Mutex<Vec<String>> = std::sync::Mutex::new(Vec::new());
+
 fn print(scene: &str, frames: usize, native: &Run, topple: &Run) {
+    CPU_ROWS
+        .lock()
+        .unwrap_or_else(|e| e.into_inner())
+        .push(format!(
+            "| {scene} | {:.3} | {:.2} | {:.3} | {:.2} | {:.2} | {:.2} |",
+            native.cpu_mean_ms,
+            native.cpu_worst_ms,
+            topple.cpu_mean_ms,
+            topple.cpu_worst_ms,
+            topple.cpu_mean_ms / native.cpu_mean_ms,
+            topple.cpu_worst_ms / native.cpu_worst_ms,
+        ));
     let sane = |r: &Run| {
         if r.nan {
             "NaN".to_string()
@@ -249,5 +299,11 @@ fn main() {
         let native = pixel_scene(ImpactResponse::Native, f, ground, spawn);
         let topple = pixel_scene(ImpactResponse::Topple, f, ground, spawn);
         print("domino_show, 16 fronts, px", f, &native, &topple);
+    }
+    println!();
+    println!("| scene (CPU time of the process per frame) | native mean (ms) | native worst (ms) | topple mean (ms) | topple worst (ms) | mean ratio | worst ratio |");
+    println!("| --- | --- | --- | --- | --- | --- | --- |");
+    for row in CPU_ROWS.lock().unwrap_or_else(|e| e.into_inner()).iter() {
+        println!("{row}");
     }
 }

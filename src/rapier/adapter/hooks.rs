@@ -51,6 +51,14 @@ pub struct ToppleHooks {
     /// topple's: the step's impact threshold
     /// ([`super::scale::effective`]).
     pub(crate) min_approach_speed: f64,
+    /// The threshold of a pair with e > 0 that Rapier has not held lately
+    /// (world units per second): that of one Rapier step of the
+    /// frame's sub-steps ([`super::scale::rebound_threshold`]), at most
+    /// `min_approach_speed` (docs/bevy.md, "Rebounds and chatter").
+    pub(crate) rebound_speed: f64,
+    /// The frame being stepped (never 0): stamped into the manifold of each
+    /// pair Rapier holds ([`ToppleHooks::held_lately`]).
+    frame: u32,
     /// The step's work budget is spent: every pair gets Rapier's own
     /// response until the step ends.
     pub(crate) stand_aside: bool,
@@ -67,6 +75,11 @@ pub struct ToppleHooks {
 
 const UNMANAGED: u16 = u16::MAX;
 
+/// Frames before the present one in which a push of Rapier's contact
+/// solver still counts the pair as held (docs/bevy.md, "Rebounds and
+/// chatter": one frame, measured against 2 and 4 on the Table 1 rows).
+pub(crate) const HELD_FRAMES: u32 = 1;
+
 /// A collider pair as one number (arena indices, smaller first).
 #[inline]
 pub(crate) fn pair_key(a: ColliderHandle, b: ColliderHandle) -> u64 {
@@ -81,11 +94,46 @@ impl ToppleHooks {
             collider_material: Vec::new(),
             mode,
             min_approach_speed: 0.0,
+            rebound_speed: 0.0,
+            frame: 1,
             stand_aside: false,
             taken: Mutex::new(Vec::new()),
             left: Mutex::new(Vec::new()),
             reported: HashSet::new(),
             native: AtomicU64::new(0),
+        }
+    }
+
+    /// Starts a frame (a step of the caller): the impact threshold of pairs
+    /// Rapier holds and the lower one of pairs it has not held lately
+    /// (world units per second).
+    pub(crate) fn begin_frame(&mut self, threshold: f64, rebound: f64) {
+        self.min_approach_speed = threshold;
+        self.rebound_speed = rebound.min(threshold);
+        self.frame = self.frame.wrapping_add(1).max(1);
+    }
+
+    /// Whether Rapier's contact solver pushed on a manifold (any of its
+    /// points) in this frame or the [`HELD_FRAMES`] before it, from the stamp
+    /// the hook leaves in its `user_data` ([`ToppleHooks::modify`]).
+    #[inline]
+    pub(crate) fn held_lately(&self, stamp: u32) -> bool {
+        stamp != 0 && self.frame.wrapping_sub(stamp) <= HELD_FRAMES
+    }
+
+    /// The impact threshold (world units per second) of a manifold with
+    /// this stamp between materials of this restitution: the frame's while
+    /// Rapier holds the pair or lately has, and for a plastic pair (e = 0,
+    /// where Rapier's own response, restitution 0 with Coulomb friction, is
+    /// the law's answer to a slow approach); the rebound threshold for a
+    /// pair with e > 0 that Rapier has not held lately (docs/bevy.md,
+    /// "Rebounds and chatter").
+    #[inline]
+    pub(crate) fn threshold_of(&self, stamp: u32, restitution: f64) -> f64 {
+        if restitution <= 0.0 || self.held_lately(stamp) {
+            self.min_approach_speed
+        } else {
+            self.rebound_speed
         }
     }
 
@@ -158,16 +206,10 @@ impl ToppleHooks {
                 .unwrap_or_default()
         };
         let (b1, b2) = (context.rigid_body1, context.rigid_body2);
-        let threshold = self.min_approach_speed as Real;
-        // Rapier's own notion of a lasting contact: the point existed at the
-        // last contact update and touches. Its approach in discrete time (of
-        // order g·Δt and v_t·ω·Δt on a sliding or pivoting contact) is
-        // Rapier's to hold; so is every point slower than the threshold.
-        let rapiers = |c: &super::backend::prelude::SolverContact| {
-            let lasting = c.contact_id[0] & NEW_CONTACT_BIT == 0 && c.dist <= 0.0;
-            let vn = (velocity(b2, c.anchor2) - velocity(b1, c.anchor1)).dot(n);
-            lasting || vn >= -threshold
-        };
+        // Rapier pushed on the pair in its last step: stamp the frame
+        if context.manifold.points.iter().any(|p| p.data.impulse > 0.0) {
+            *context.user_data = self.frame;
+        }
         let support = if self.stand_aside {
             Err(None)
         } else {
@@ -177,6 +219,28 @@ impl ToppleHooks {
                 context.collider1,
                 context.collider2,
             )
+        };
+        // a composite shape keeps the frame's threshold: parry can miss a
+        // sub-shape's points at the gaps where the pass resolves an impact
+        // (a flat face across a polyline's vertex), and a slow approach the
+        // pass cannot resolve must stay Rapier's
+        let threshold = match support {
+            Ok(support::Geometry::Convex) => {
+                self.threshold_of(*context.user_data, pair.impact.restitution)
+            }
+            _ => self.min_approach_speed,
+        } as Real;
+        // Rapier's own notion of a lasting contact: the point carried an
+        // impulse in Rapier's last step and touches. Its approach in
+        // discrete time (of order g·Δt and v_t·ω·Δt on a sliding or
+        // pivoting contact) is Rapier's to hold; so is every point slower
+        // than the pair's threshold: the frame's while Rapier holds the pair
+        // or lately has (chatter of its soft contact) and for a plastic
+        // pair, the sub-step's once it has not (a rebound or a landing).
+        let rapiers = |c: &super::backend::prelude::SolverContact| {
+            let lasting = c.contact_id[0] & NEW_CONTACT_BIT == 0 && c.dist <= 0.0;
+            let vn = (velocity(b2, c.anchor2) - velocity(b1, c.anchor1)).dot(n);
+            lasting || vn >= -threshold
         };
         if let Err(notice) = support {
             // Rapier's, as native Rapier

@@ -11,6 +11,7 @@
 //! | setting | used in the step |
 //! | --- | --- |
 //! | impact threshold | max(`min_approach_speed` · L, 2 \|g\| Δt): 2 \|g\| Δt is the approach a resting contact picks up in one step, so a stack at rest has no impacts |
+//! | rebound threshold | max(`min_approach_speed` · L, 2 \|g\| Δt/n) for a step cut into n sub-steps: the threshold of a pair Rapier has not held in this step or the last ([`rebound_threshold`]) |
 //! | closed tolerance | max(`patch.closed_tolerance` · L, 64 ε · max(L, 1)) |
 //! | flat tolerance | max(`patch.flat_tolerance` · L, 64 ε · max(L, 1)) |
 //! | shortest patch | `patch.min_patch_length` · L |
@@ -48,4 +49,28 @@ pub(crate) fn effective(
         },
         ..*s
     }
+}
+
+/// The impact threshold (world units/s) of a managed pair that Rapier's
+/// contact solver has not held in this step or the last, for a step cut
+/// into `substeps` Rapier steps: max(`min_approach_speed` · L, 2 |g| Δt/n),
+/// twice the approach a resting contact picks up in one of those Rapier
+/// steps. A pair Rapier holds keeps the step's threshold 2 |g| Δt: its
+/// slower approaches are the chatter of Rapier's soft contact (docs/bevy.md,
+/// "Rebounds and chatter").
+pub(crate) fn rebound_threshold(
+    s: &ToppleSettings,
+    gravity: Vector,
+    params: &IntegrationParameters,
+    substeps: usize,
+) -> f64 {
+    let scaled = effective(s, gravity, params);
+    let finite = |x: f64| if x.is_finite() { x } else { 0.0 };
+    let l = f64::from(params.length_unit);
+    let l = if l.is_finite() && l > 0.0 { l } else { 1.0 };
+    let g = finite(f64::from(gravity.length()));
+    let h = finite(f64::from(params.dt)).max(0.0) / substeps.max(1) as f64;
+    (s.min_approach_speed * l)
+        .max(2.0 * g * h)
+        .min(scaled.min_approach_speed)
 }

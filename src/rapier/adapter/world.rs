@@ -165,7 +165,8 @@ impl ToppleRapier {
     pub fn set_settings(&mut self, settings: ToppleSettings) {
         self.settings = settings;
         self.effective = settings;
-        self.hooks.min_approach_speed = settings.min_approach_speed;
+        self.hooks
+            .begin_frame(settings.min_approach_speed, settings.min_approach_speed);
     }
 
     /// The settings of the last step in the world's units: the impact
@@ -306,10 +307,10 @@ impl ToppleRapier {
         events: &dyn EventHandler,
     ) -> usize {
         self.pass.clear_step();
-        self.prepare(parts.gravity, parts.integration_parameters);
-        self.insert_fresh(&mut parts);
         let dt = parts.integration_parameters.dt;
         let n = self.substeps(f64::from(dt));
+        self.prepare(parts.gravity, parts.integration_parameters, n);
+        self.insert_fresh(&mut parts);
         // the sub-step boundaries; the last one is exactly dt
         let boundary = |k: usize| {
             if k >= n {
@@ -402,9 +403,11 @@ impl ToppleRapier {
 
     /// Before a step: the settings in the world's units, the work budget,
     /// the hook's threshold.
-    fn prepare(&mut self, gravity: Vector, params: &IntegrationParameters) {
+    fn prepare(&mut self, gravity: Vector, params: &IntegrationParameters, substeps: usize) {
         self.effective = scale::effective(&self.settings, gravity, params);
-        self.hooks.min_approach_speed = self.effective.min_approach_speed;
+        let rebound = scale::rebound_threshold(&self.settings, gravity, params, substeps);
+        self.hooks
+            .begin_frame(self.effective.min_approach_speed, rebound);
         self.hooks.stand_aside = false;
         self.pass.work_left = self.settings.fallback.max_work;
     }
@@ -500,7 +503,7 @@ impl ToppleRapier {
         bodies: &RigidBodySet,
     ) {
         self.pass.clear_step();
-        self.prepare(gravity, integration_parameters);
+        self.prepare(gravity, integration_parameters, 1);
         self.record_start(islands, bodies);
     }
 

@@ -23,6 +23,22 @@ fn body_radius(world: &World, rb: &RigidBody) -> f64 {
         .fold(0.0, f64::max)
 }
 
+/// The impact threshold of a managed pair (world units/s), as the hook
+/// sets it ([`ToppleHooks::threshold_of`]): the frame's if Rapier held any
+/// of its manifolds lately (the stamp the hook leaves) or the pair is
+/// plastic, the rebound threshold otherwise, also for a pair not in
+/// Rapier's narrow phase (docs/bevy.md, "Rebounds and chatter").
+fn pair_threshold(world: &World, hooks: &ToppleHooks, a: ColliderHandle, b: ColliderHandle) -> f64 {
+    let restitution = hooks.pair(a, b).map_or(0.0, |m| m.impact.restitution);
+    let stamp = world.narrow_phase.contact_pair(a, b).and_then(|pair| {
+        pair.manifolds
+            .iter()
+            .map(|m| m.data.user_data)
+            .find(|&s| hooks.held_lately(s))
+    });
+    hooks.threshold_of(stamp.unwrap_or(0), restitution)
+}
+
 impl ImpactPass {
     /// The bounding radius of a body (m), cached: computed again only when
     /// its number of colliders changes (a collider whose shape is replaced in
@@ -97,6 +113,11 @@ impl ImpactPass {
             key,
             toi: f64::INFINITY,
             done: false,
+            threshold: match geometry {
+                // as the hook: composite shapes keep the frame's threshold
+                support::Geometry::Convex => pair_threshold(world, hooks, a, b),
+                support::Geometry::Composite => hooks.min_approach_speed,
+            },
         });
     }
 

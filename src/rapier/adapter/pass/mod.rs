@@ -41,6 +41,10 @@ struct Candidate {
     toi: f64,
     /// Resolved (or found not to approach) in this step.
     done: bool,
+    /// The pair's impact threshold (world units/s): the frame's while
+    /// Rapier holds the pair, lower once it has not lately
+    /// ([`ToppleHooks::threshold_of`]).
+    threshold: f64,
 }
 
 /// One group of bodies resolved at one instant of the step.

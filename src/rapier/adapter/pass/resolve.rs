@@ -22,6 +22,8 @@ impl ImpactPass {
         offset: f64,
     ) -> usize {
         let at_once = 1e-9 * self.motion.dt;
+        // the lowest threshold of the pairs closing now starts the impact
+        let mut threshold = settings.min_approach_speed;
         self.bodies.clear();
         self.handles.clear();
         self.contacts.clear();
@@ -32,6 +34,7 @@ impl ImpactPass {
                 continue;
             }
             self.candidates[k].done = true;
+            threshold = threshold.min(c.threshold);
             self.queried.push(c.key);
             self.query_pair(
                 world,
@@ -58,12 +61,16 @@ impl ImpactPass {
         };
         self.expand_group(world, hooks, &window, t);
         self.contact_points += self.contacts.len() as u64;
-        // the impacts of a step share its work budget
+        // the impacts of a step share its work budget; an impact started
+        // below the frame's threshold (a rebound) still ends at the frame's
+        // rest speed
         let budgeted = ToppleSettings {
             fallback: FallbackPolicy {
                 max_work: self.work_left,
                 ..settings.fallback
             },
+            impact: settings.impact_settings(),
+            min_approach_speed: threshold,
             ..*settings
         };
         let groups = self
