@@ -155,7 +155,7 @@ impl Integrator {
                             };
                             out[1] = Some(Watch::both(
                                 Switch::Closes(i),
-                                (q, 1.0, point.close_at),
+                                (q, 1.0, 0.0),
                                 (rate, -1.0, fast),
                             ));
                         }

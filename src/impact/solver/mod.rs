@@ -189,14 +189,8 @@ struct PointState {
     held_force: f64,
     /// Largest compression reached (m).
     peak: f64,
-    /// q ≤ 0 at the start of the present step, or within the rounding of
-    /// zero while a patch waits for its load (an onset is watched).
+    /// q ≤ 0 at the start of the present step (an onset is watched).
     open: bool,
-    /// The compression at which the onset of an open point is a switch:
-    /// 0 for a gap, the rounding of zero (`Row::q_zero`) for a point that
-    /// starts the step within it, where it does not carry load yet
-    /// (modes.rs, `carries_load`) (m).
-    close_at: f64,
     /// An e = 0 point whose energy has just been lost after a load cycle
     /// short enough to be held closed from now on (see
     /// [`ImpactSettings::fast_cycle`]).

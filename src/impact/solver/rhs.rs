@@ -184,7 +184,7 @@ impl Integrator {
             PointMode::Compress => {
                 (rate > thr && q > row.q_load)
                     || (point.open
-                        && q > point.close_at
+                        && q > 0.0
                         && (rate < -self.scales.onset || self.onset_matters(i)))
             }
             PointMode::Expand => rate < -thr || q < -row.q_zero,
