@@ -4,15 +4,32 @@
 use crate::impact::audit::AuditSummary;
 use crate::validate::box_overlap;
 
-/// A block counts as fallen past this tilt (rad). A block first touches the
+/// A block counts as fallen past this tilt (rad) once it lies on what it
+/// leans towards ([`LYING_GAP`], [`LYING_TIME`]). A block first touches the
 /// next one at a tilt asin(s/h) < π/4 for every s/h the sweep draws (< 0.6),
 /// and past π/4 it mostly lies on a block that only moves forward. Not
 /// always: a block that first meets its neighbour near π/4 (s/h near 0.6)
-/// can rebound off it, and a leaning train at small spacing rests near π/4
-/// (face to face at acos(d/(s + d)), 50° for Domino X at s/h 0.1) and rocks
-/// about it. A Rapier run's drop of the fallen count is therefore checked
-/// against the same row in the reference engine (`docs/stress.md`).
+/// can strike it past π/4 and rebound off it (Table 1's e1 reverses the
+/// striker); it never lay on it, so it had not fallen. A leaning train at
+/// small spacing rests near π/4 (face to face at acos(d/(s + d)), 50° for
+/// Domino X at s/h 0.1) and rocks about it; a Rapier run's drop of the
+/// fallen count is therefore also checked against the same row in the
+/// reference engine (`docs/stress.md`).
 pub const FALLEN_TILT: f64 = std::f64::consts::FRAC_PI_4;
+
+/// A block past [`FALLEN_TILT`] touches a block it leans towards (or lies
+/// on the ground with two corners) when the gap between them is at most this
+/// fraction of the block height: separating axes of the two outlines from
+/// the poses. The reference closes contacts to 10⁻⁶ h and Rapier's rest in
+/// its allowed error (−0.005 h); a block rebounding at 2 rad/s opens 10⁻³ h
+/// in half a millisecond.
+pub const LYING_GAP: f64 = 1e-3;
+
+/// … and lies on it once it has touched it at every look for this long (s)
+/// and at two looks at least. An impact lasts microseconds (a Rapier step at
+/// most, 1/30 s); a block that struck its neighbour and rebounds leaves it at
+/// once, one that lies on it stays.
+pub const LYING_TIME: f64 = 0.01;
 
 /// The observations of one run.
 #[derive(Clone, Debug, Default, PartialEq)]
@@ -31,9 +48,11 @@ pub struct Observation {
     pub deepest: Vec<(f64, Vec<[f64; 3]>)>,
     /// The same looks around the first drop of the fallen count.
     pub dropped: Vec<(f64, Vec<[f64; 3]>)>,
-    /// Largest drop of the fallen count between two observed instants.
+    /// Largest drop of the fallen count between two observed instants: the
+    /// fallen blocks that came back below [`FALLEN_TILT`] at one look.
     pub fallen_drop: usize,
-    /// Blocks fallen at the end.
+    /// Blocks fallen at the end (past [`FALLEN_TILT`], and lying on a block
+    /// or on the ground since they passed it).
     pub fallen: usize,
     /// For a Rapier run whose fallen count dropped: the largest drop of the
     /// same row in the reference engine (`None` if it could not be run).
@@ -43,16 +62,20 @@ pub struct Observation {
     /// that strikes its neighbour rebounds (Table 1's e1 reverses the
     /// striker, the paper's reversed blocks), by a degree or two.
     pub fallen_rock_back: f64,
-    /// The same, only for blocks whose rock-back took them back below
-    /// [`FALLEN_TILT`] (0 if none did): how far a block that stood up
+    /// The same, only for fallen blocks whose rock-back took them back
+    /// below [`FALLEN_TILT`] (0 if none did): how far a block that stood up
     /// again had come back from its largest tilt.
     pub stood_up_rock_back: f64,
+    /// Blocks that passed [`FALLEN_TILT`] and came back below it without
+    /// having lain on anything in between (a rebound off the block struck):
+    /// reported, not a drop.
+    pub rebounds: usize,
     /// For a Rapier run whose fallen count dropped: the reference engine's
     /// [`Observation::fallen_rock_back`] on the same row (`None` if it could
     /// not be run).
     pub reference_rock_back: Option<f64>,
-    /// Blocks (1-based) that came back below [`FALLEN_TILT`] after passing
-    /// it, in the order they first did.
+    /// Fallen blocks (1-based) that came back below [`FALLEN_TILT`], in the
+    /// order they first did.
     pub stood_up: Vec<usize>,
     /// Blocks hit by the wave.
     pub hits: usize,
@@ -68,6 +91,17 @@ pub struct Observation {
     pub audit: AuditSummary,
     /// An error the engine returned (the run could not be done).
     pub error: Option<String>,
+}
+
+/// One block towards the fallen count.
+#[derive(Clone, Copy, Debug, Default)]
+struct Lying {
+    /// Past [`FALLEN_TILT`] since its last look below it.
+    past: bool,
+    /// Since when (time, look) it has touched what it leans on, while past.
+    since: Option<(f64, usize)>,
+    /// It has lain on a block or the ground since it passed: fallen.
+    lain: bool,
 }
 
 /// Tracks the states of a row of blocks of height `h`, thickness `d`
@@ -90,9 +124,10 @@ pub struct RowWatch {
     reach: f64,
     /// The last looks, oldest first (for `Observation::deepest`).
     recent: std::collections::VecDeque<(f64, Vec<[f64; 3]>)>,
-    last_fallen: Option<usize>,
     /// Largest tilt (rad, absolute) of every block so far.
     peak: Vec<f64>,
+    /// Every block's state towards the fallen count.
+    lying: Vec<Lying>,
     looks: usize,
     /// What has been seen so far.
     pub seen: Observation,
@@ -106,8 +141,8 @@ impl RowWatch {
             h,
             reach: h.hypot(d),
             recent: std::collections::VecDeque::new(),
-            last_fallen: None,
             peak: Vec::new(),
+            lying: Vec::new(),
             looks: 0,
             seen: Observation::default(),
         }
@@ -151,31 +186,74 @@ impl RowWatch {
             self.seen.penetration_at = format!("{} at t = {time:.4} s", worst.1);
             self.seen.deepest = self.moments();
         }
-        let fallen = blocks.iter().filter(|b| b[2].abs() > FALLEN_TILT).count();
         self.peak.resize(blocks.len(), 0.0);
-        for (k, (b, peak)) in blocks.iter().zip(&mut self.peak).enumerate() {
-            let tilt = b[2].abs();
+        self.lying.resize(blocks.len(), Lying::default());
+        let mut drop = 0;
+        for k in 0..blocks.len() {
+            let tilt = blocks[k][2].abs();
+            let peak = &mut self.peak[k];
             *peak = peak.max(tilt);
             if *peak > FALLEN_TILT {
                 let back = *peak - tilt;
                 self.seen.fallen_rock_back = self.seen.fallen_rock_back.max(back);
-                if tilt <= FALLEN_TILT {
+            }
+            let state = &mut self.lying[k];
+            if tilt <= FALLEN_TILT {
+                if state.lain {
+                    drop += 1;
+                    let back = self.peak[k] - tilt;
                     self.seen.stood_up_rock_back = self.seen.stood_up_rock_back.max(back);
                     if !self.seen.stood_up.contains(&(k + 1)) {
                         self.seen.stood_up.push(k + 1);
                     }
+                } else if state.past {
+                    self.seen.rebounds += 1;
                 }
+                *state = Lying::default();
+                continue;
+            }
+            state.past = true;
+            if state.lain {
+                continue;
+            }
+            let touching = self.touches(blocks, k);
+            let state = &mut self.lying[k];
+            if touching {
+                let since = *state.since.get_or_insert((time, self.looks));
+                if time - since.0 >= LYING_TIME && self.looks > since.1 {
+                    state.lain = true;
+                }
+            } else {
+                state.since = None;
             }
         }
-        if let Some(last) = self.last_fallen {
-            let drop = last.saturating_sub(fallen);
-            if drop > 0 && self.seen.dropped.is_empty() {
-                self.seen.dropped = self.moments();
-            }
-            self.seen.fallen_drop = self.seen.fallen_drop.max(drop);
+        if drop > 0 && self.seen.dropped.is_empty() {
+            self.seen.dropped = self.moments();
         }
-        self.last_fallen = Some(fallen);
-        self.seen.fallen = fallen;
+        self.seen.fallen_drop = self.seen.fallen_drop.max(drop);
+        self.seen.fallen = self.lying.iter().filter(|l| l.lain).count();
+    }
+
+    /// Whether block `k` touches (within [`LYING_GAP`] h) a block whose
+    /// centre lies on the side it leans towards, or the ground with two of
+    /// its corners (it lies on its face).
+    fn touches(&self, blocks: &[[f64; 3]], k: usize) -> bool {
+        let b = blocks[k];
+        let tol = LYING_GAP * self.h;
+        // φ counter-clockwise: a negative angle leans towards +x
+        let side = -b[2].signum();
+        let on_block = blocks.iter().enumerate().any(|(j, o)| {
+            j != k
+                && (o[0] - b[0]) * side > 0.0
+                && (o[0] - b[0]).hypot(o[1] - b[1]) < self.reach
+                && box_overlap(([b[0], b[1]], b[2]), ([o[0], o[1]], o[2]), self.half) >= -tol
+        });
+        let (s, c) = b[2].sin_cos();
+        let corners_down = [(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)]
+            .iter()
+            .filter(|(u, v)| b[1] + s * u * self.half[0] + c * v * self.half[1] <= tol)
+            .count();
+        on_block || corners_down >= 2
     }
 
     /// The last look and up to three before it, ten looks apart, oldest

@@ -294,6 +294,29 @@ fn combo_2555_of_the_third_full_sweep_runs_clean() {
     assert!(o.penetration < 0.01);
 }
 
+/// Combo 2400 of `topple stress --full --seed 1` (Domino X, Table 1, s/h
+/// 0.474, push 1.11, Δt 0.1 ms, 12 blocks): block 5 strikes block 6 at
+/// 45.50°, the impact throws it back (θ̇ −3.1 rad/s) to 44.99°, and it falls
+/// on to 73.5° later, onto block 6. The model itself turns the striker back
+/// across π/4 (e1 = 0.85 reverses strikers); block 5 never lay on block 6
+/// before, so it had not fallen: a rebound, not a drop of the fallen count
+/// (before, every block past π/4 counted, and the sweep called this a
+/// violation of the reference).
+#[test]
+fn the_reference_rebound_at_a_quarter_turn_in_combo_2400_is_not_a_drop() {
+    let spec = SweepSpec::full(1);
+    let c = draw(1, 2400, spec.n_lo, spec.n_hi);
+    assert_eq!(c.engine, StressEngine::Reference);
+    let o = run_combo(&c, 120.0);
+    assert!(o.error.is_none() && !o.over_budget, "{o:?}");
+    assert_eq!(o.rebounds, 1, "block 5's rebound off block 6");
+    assert_eq!(o.fallen_drop, 0);
+    // blocks lie on their neighbours behind the wave
+    assert!(o.fallen >= 5, "{} fallen", o.fallen);
+    let v = violations(&c, &o);
+    assert!(v.is_empty(), "{v:?}");
+}
+
 /// A block lying on its face, a block standing 5 h away, and a block lying
 /// on its face 0.05 h above the first, shifted by h/4 along it: the third
 /// block falls onto the first, which is not its neighbour, and comes to

@@ -193,7 +193,7 @@ fn describe(c: &SceneCombo, o: &SceneObservation) -> String {
         o.penetration_excess,
         o.penetration_excess_at,
         o.native
-            .map(|(p, t)| format!(", native: {p:.3}{}", if t { " and through the ground" } else { "" }))
+            .map(|(p, t)| format!(", native: {p:.3}{}", if t { " and a centre below the ground" } else { "" }))
             .unwrap_or_default(),
         o.through_ground
             .as_deref()
