@@ -22,8 +22,7 @@
 //! Whether each row's force is admissible (λ ≥ 0, |f| ≤ μ_s N) is not this
 //! stage's business: the event stage watches it and changes the set.
 
-use super::load::{Axis, BodySlot};
-use super::rhs::{push, rate};
+use super::data::{push, rate, Axis, BodySlot};
 
 /// What a constraint row holds.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

@@ -23,27 +23,9 @@
 //! back to the earliest switch, every switch due there is applied, and the
 //! modes are settled at that instant (modes.rs).
 
-use super::load::Axis;
-use super::rk::Rk;
-use super::{Integrator, PatchMode, PointMode};
-
-/// A switch located inside a step.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub(super) enum Switch {
-    /// A point's compression ends.
-    CompressionEnds(usize),
-    /// An expanding point is pushed in again.
-    Recompresses(usize),
-    /// A loaded point's compression reaches zero.
-    LetsGo(usize),
-    /// An open point's gap closes.
-    Closes(usize),
-    /// A sliding patch's slip reaches zero.
-    SlipStops(usize),
-    /// The hold of an e > 0 point has taken one fast cycle's swing: the
-    /// point loads under the law from here (docs/model.md §8).
-    HoldSpent(usize),
-}
+use super::data::{Axis, PatchMode, PointMode, Suspect, Switch};
+use super::tableau::Rk;
+use super::Integrator;
 
 /// Switches closer than this fraction of a step to the earliest one are
 /// applied with it (points of one flat face letting go together).
@@ -318,13 +300,6 @@ impl Watch {
             None => one(self.first),
         }
     }
-}
-
-/// A point or a patch noted by the probe.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub(super) enum Suspect {
-    Point(usize),
-    Patch(usize),
 }
 
 /// (state index, weight) of the rate along `axis` of body `b` against `a`.

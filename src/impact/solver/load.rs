@@ -11,152 +11,9 @@
 
 use super::super::contact::cross;
 use super::super::{Body, Contact};
+use super::data::{Axis, BodySlot, Layout, Patch, PatchMode, PointState, Row, Scales};
 use super::law::Law;
-use super::{Integrator, PatchMode, PointState};
-
-/// A body slot: inverse mass and inertia (0 for fixed bodies and the world)
-/// and the radius of gyration ρ = √(I/m) that turns ω errors into speeds.
-#[derive(Clone, Copy, Debug, Default)]
-pub(super) struct BodySlot {
-    pub inv_mass: f64,
-    pub inv_inertia: f64,
-    pub gyration: f64,
-}
-
-/// A direction of impulse on a pair of bodies with its moment arms r × dir.
-#[derive(Clone, Copy, Debug, Default)]
-pub(super) struct Axis {
-    pub dir: [f64; 2],
-    pub arm_a: f64,
-    pub arm_b: f64,
-}
-
-impl Axis {
-    /// `self − c · other` (the direction of a held normal force that drags
-    /// sliding friction along).
-    pub fn minus(self, c: f64, other: Axis) -> Axis {
-        Axis {
-            dir: [
-                self.dir[0] - c * other.dir[0],
-                self.dir[1] - c * other.dir[1],
-            ],
-            arm_a: self.arm_a - c * other.arm_a,
-            arm_b: self.arm_b - c * other.arm_b,
-        }
-    }
-}
-
-/// Frozen geometry and law of one contact point.
-#[derive(Clone, Copy, Debug)]
-pub(super) struct Row {
-    /// Body slots; the first body takes −F, the second +F.
-    pub a: usize,
-    pub b: usize,
-    pub normal: Axis,
-    /// The direction F pushes along: the normal, plus −μ s times the
-    /// tangent while the point's patch slides with sign s (kept by
-    /// `Integrator::set_patch`), and the friction factor −μ s itself.
-    pub drive: Axis,
-    pub slide: f64,
-    /// 1/m and 1/I of body a, then of body b (0 for fixed bodies).
-    pub inverse: [f64; 4],
-    pub law: Law,
-    /// Friction patch (see [`Patch`]).
-    pub patch: usize,
-    /// W_nn = J_n M⁻¹ J_nᵀ (1/kg).
-    pub w_nn: f64,
-    /// Compression that would store the energy of an approach at the
-    /// impact's velocity scale (m): the scale of q's error.
-    pub q_scale: f64,
-    /// Compressions within ± this (10⁻¹² q_scale) count as zero (m).
-    pub q_zero: f64,
-    /// A point whose compression stays below this (10⁻⁶ q_scale, m) has not
-    /// loaded: when it separates its (negligible) energy is not booked as
-    /// a compression that ended.
-    pub q_load: f64,
-    /// False when neither body can move: such a contact takes no part.
-    pub movable: bool,
-}
-
-/// Contacts of one body pair whose tangential rows are the same (the points
-/// of one flat face: r × t is the distance of the face's line from each
-/// centre of mass, the same for every point on it). Coulomb's law per point
-/// with one shared slip velocity is exactly Coulomb's law of the patch with
-/// the summed normal force, so stick and slip are decided per patch: its
-/// constraint rows stay independent where the points' would not.
-#[derive(Clone, Copy, Debug)]
-pub(super) struct Patch {
-    pub a: usize,
-    pub b: usize,
-    pub tangent: Axis,
-    /// W_tt (1/kg).
-    pub w_tt: f64,
-    /// Sliding μ and the sticking bound max(μ_s, μ); μ = ∞: no slip.
-    pub friction: f64,
-    pub stick_bound: f64,
-    /// Members: `members[first..first + count]`.
-    pub first: usize,
-    pub count: usize,
-}
-
-impl Patch {
-    pub fn no_slip(&self) -> bool {
-        self.friction == f64::INFINITY
-    }
-
-    pub fn frictionless(&self) -> bool {
-        self.w_tt <= 0.0 || (self.friction == 0.0 && self.stick_bound == 0.0)
-    }
-}
-
-/// Scales of one impact, fixed at its start.
-#[derive(Clone, Copy, Debug, Default)]
-pub(super) struct Scales {
-    /// Largest approach speed at the start (m/s).
-    pub velocity: f64,
-    /// Normal and tangential rates within ± this are taken as zero (m/s):
-    /// rounding left after landing on a switch.
-    pub rate: f64,
-    /// A point that starts to load approaching faster than this (10⁻³ of
-    /// the velocity scale, m/s) starts a segment of its own (its force grows
-    /// as t^α, see `Variable::Root`).
-    pub onset: f64,
-    /// The shortest time scale of the points approaching at the start (s,
-    /// law.rs).
-    pub time: f64,
-    /// Accelerations within ± this are taken as zero (m/s²): the rate
-    /// threshold over the time scale. A sliding patch whose slip and slip
-    /// acceleration are both zero to this rounding has its slip fixed by
-    /// other rows (a closed loop of stuck patches) and keeps its mode.
-    pub accel: f64,
-}
-
-/// Offsets of the state vector's parts.
-#[derive(Clone, Copy, Debug, Default)]
-pub(super) struct Layout {
-    /// Body slots, the world included.
-    pub bodies: usize,
-    pub contacts: usize,
-}
-
-impl Layout {
-    pub fn q(&self, i: usize) -> usize {
-        3 * self.bodies + i
-    }
-    pub fn pn(&self, i: usize) -> usize {
-        3 * self.bodies + self.contacts + i
-    }
-    pub fn pt(&self, i: usize) -> usize {
-        3 * self.bodies + 2 * self.contacts + i
-    }
-    /// The time (s) since the impact started.
-    pub fn time(&self) -> usize {
-        3 * (self.bodies + self.contacts)
-    }
-    pub fn len(&self) -> usize {
-        3 * (self.bodies + self.contacts) + 1
-    }
-}
+use super::Integrator;
 
 /// Same direction, same arms: the tangential rows of two points coincide.
 fn same_axis(x: &Axis, y: &Axis, length: f64) -> bool {
@@ -267,7 +124,7 @@ impl Integrator {
         let mut speed: f64 = 0.0;
         for i in 0..n {
             if self.rows[i].movable {
-                speed = speed.max(-super::rhs::normal_rate(&self.rows[i], &self.y));
+                speed = speed.max(-super::data::normal_rate(&self.rows[i], &self.y));
             }
         }
         let mut time = f64::INFINITY;
@@ -276,7 +133,7 @@ impl Integrator {
                 row.q_scale = row.law.compression(0.5 * speed * speed / row.w_nn);
                 row.q_zero = 1e-12 * row.q_scale;
                 row.q_load = 1e-6 * row.q_scale;
-                let rate = super::rhs::normal_rate(row, &self.y);
+                let rate = super::data::normal_rate(row, &self.y);
                 if rate < 0.0 {
                     time = time.min(row.law.time_scale(-rate, row.w_nn));
                 }

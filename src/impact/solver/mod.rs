@@ -15,17 +15,20 @@
 //!
 //! | file | stage |
 //! | --- | --- |
+//! | `data.rs` | what the stages share: frozen rows and patches, modes, switches, kinematics |
 //! | `load.rs` | bodies, contact rows, friction patches, scales, the initial state |
 //! | `law.rs` | the contact law: force, stored energy, dq/dt in compression and expansion |
 //! | `rhs.rs` | dy/dt: normal forces, sliding friction, constraint forces; the probe of each mode's condition |
 //! | `constraints.rs` | stuck patches and held points: A = J M⁻¹ Dᵀ factored once per set, solved per evaluation |
-//! | `rk.rs` | one Dormand–Prince 5(4) step, its error estimate and interpolant |
+//! | `tableau.rs` | the Dormand–Prince 5(4) pair: stages, error estimate, interpolant |
+//! | `rk.rs` | one step of the pair on the impact, its error norm |
 //! | `events.rs` | the switches inside a step, located on the interpolant |
 //! | `modes.rs` | the modes at an instant: touching points, stick and slip, held points |
 //! | `run.rs` | step size control, free flight, the end of the impact |
 //! | `energy.rs` | the outcome and its energy guard |
 
 mod constraints;
+mod data;
 mod energy;
 mod events;
 mod law;
@@ -34,14 +37,17 @@ mod modes;
 mod rhs;
 mod rk;
 mod run;
+mod tableau;
 
 use super::impulse::{ImpulseScheme, ImpulseStepper};
 use super::{
     capture, validate, Body, Contact, ImpactError, ImpactOutcome, ImpactSettings, StepControl,
 };
 use constraints::Constraints;
-use events::{Suspect, Switch};
-use load::{Axis, BodySlot, Layout, Patch, Row, Scales};
+use data::{
+    Axis, BodySlot, Clock, Layout, Patch, PatchMode, PatchState, PointState, Row, Scales, Suspect,
+    Switch,
+};
 
 /// The fast-cycle bound of an e > 0 point as a fraction of
 /// [`ImpactSettings::fast_cycle`] (docs/model.md §8, "Fast bounces at
@@ -150,123 +156,6 @@ impl ImpactSolver {
     }
 }
 
-/// What a point does at present.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-enum PointMode {
-    /// The compression law: dq/dt = −δ̇ and F = k max(q, 0)^α. It covers
-    /// the open gap (q < 0, no force), the touching point (q = 0: it loads
-    /// as soon as it is pushed in, and separates without a switch) and the
-    /// compression phase (δ̇ ≤ 0).
-    #[default]
-    Compress,
-    /// The expansion law of a point with e > 0 after its compression ended:
-    /// dq/dt = −δ̇/e², F = k q^α.
-    Expand,
-    /// Held closed by a force λ ≥ 0 that keeps δ̇ constant (zero, to the
-    /// rounding of the switch).
-    Held,
-}
-
-/// What a friction patch does at present.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
-enum PatchMode {
-    /// No friction: a frictionless patch, or a patch without slip that
-    /// carries no load.
-    #[default]
-    Idle,
-    /// No slip: a constraint row.
-    Stick,
-    /// Slipping with sign s of v_t: friction −μ s N.
-    Slide(f64),
-}
-
-/// The evolving state of one point besides y.
-#[derive(Clone, Copy, Debug, Default)]
-struct PointState {
-    mode: PointMode,
-    /// F = k q^α and the held force λ of the last evaluation (N).
-    force: f64,
-    held_force: f64,
-    /// Largest compression reached (m).
-    peak: f64,
-    /// q ≤ 0 at the start of the present step (an onset is watched).
-    open: bool,
-    /// An e = 0 point whose energy has just been lost after a load cycle
-    /// short enough to be held closed from now on (see
-    /// [`ImpactSettings::fast_cycle`]).
-    released: bool,
-    /// An e > 0 point whose last load cycle (from one release to the next:
-    /// letting go, or a hold ending) moved its own rate by at most
-    /// `fast_cycle` of the velocity scale: its next closing, if it is
-    /// pushed in and approaches no faster than that, is taken by the limit
-    /// of the cycles (held closed, docs/model.md §8).
-    fast_rebound: bool,
-    /// P_n (N·s) at which the hold of an e > 0 point is spent: beyond one
-    /// fast cycle's swing the push is no longer a fast cycle, and the point
-    /// loads under the law again (∞ for e = 0 and while not held).
-    hold_limit: f64,
-    /// P_n at the start of the present load cycle (N·s).
-    cycle_start: f64,
-    /// Time (s) at which the point last switched: it does not switch again
-    /// at that same instant (a switch within 10⁻⁹ of a step is rounding),
-    /// and is not closed again at it unless it approaches.
-    switched_at: f64,
-
-    /// Probe generation in which the point was last noted.
-    seen: u32,
-}
-
-/// A patch's normal load N = Σ (F + λ) and stuck friction force of the last
-/// evaluation (N), and its switch bookkeeping (see [`PointState`]).
-#[derive(Clone, Copy, Debug)]
-struct PatchState {
-    normal: f64,
-    friction: f64,
-    seen: u32,
-    switched_at: f64,
-}
-
-impl Default for PatchState {
-    fn default() -> Self {
-        PatchState {
-            normal: 0.0,
-            friction: 0.0,
-            seen: 0,
-            switched_at: f64::NAN,
-        }
-    }
-}
-
-/// The independent variable x of the present segment.
-///
-/// The force of a point grows as (t − t₀)^α where it starts to load while
-/// approaching, and falls as (t₁ − t)^α where it lets go while separating;
-/// no polynomial in t follows either, so a fifth-order step loses its order
-/// there. A segment that starts with a point loading while it approaches
-/// uses x = √(t − t₀), in which that force is a polynomial for α = 1 and 3/2
-/// (and far smoother for any other α). A segment that ends with a point
-/// letting go uses x = σ₀ − √q of that point: q = (σ₀ − x)² exactly, its
-/// force likewise, and the point lets go at x = σ₀, where the segment ends
-/// without any search. Every other segment uses x = t − t₀. The time itself
-/// is the last component of the state.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
-enum Variable {
-    /// x = t − t₀.
-    #[default]
-    Time,
-    /// x = √(t − t₀).
-    Root,
-    /// x = σ₀ − √q of point `point`, which is expanding (e > 0).
-    End { point: usize, sigma: f64 },
-}
-
-/// The present segment's variable and x at the present state.
-#[derive(Clone, Copy, Debug, Default)]
-struct Clock {
-    variable: Variable,
-    x: f64,
-}
-
 /// The time-domain integrator (see the module docs). One per
 /// [`ImpactSolver`]; its buffers are reused from impact to impact.
 #[derive(Debug, Default)]
@@ -313,7 +202,7 @@ pub(crate) struct Integrator {
     /// Digests of the modes met by the present settling (modes.rs).
     seen_modes: Vec<u64>,
     // scratch
-    rk: rk::Rk,
+    rk: tableau::Rk,
     order: Vec<usize>,
     tangents: Vec<Axis>,
     probe_state: Vec<f64>,

@@ -24,8 +24,8 @@
 //! most a few passes; a cap ends a cycle, which the next event resolves).
 
 use super::constraints::Target;
-use super::rhs::{normal_rate, rate};
-use super::{Integrator, PatchMode, PointMode};
+use super::data::{normal_rate, rate, PatchMode, PointMode};
+use super::Integrator;
 
 impl Integrator {
     /// Settles every mode at the present state.

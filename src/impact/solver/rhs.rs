@@ -20,47 +20,8 @@
 //! notes every trial point where a mode's own condition fails, and the
 //! event stage (events.rs) locates the switch on the step's interpolant.
 
-use super::load::{Axis, BodySlot, Row};
-use super::{Integrator, PatchMode, PointMode};
-
-/// Adds force `f` along `axis` (−f on body `a`, +f on body `b`) to the
-/// accelerations `acc` ([ax, ay, α] per body slot).
-#[inline]
-pub(super) fn push(bodies: &[BodySlot], a: usize, b: usize, axis: &Axis, f: f64, acc: &mut [f64]) {
-    let (sa, sb) = (&bodies[a], &bodies[b]);
-    let inverse = [sa.inv_mass, sa.inv_inertia, sb.inv_mass, sb.inv_inertia];
-    push_with(inverse, a, b, axis, f, acc);
-}
-
-/// [`push`] with the bodies' inverse masses and inertias given.
-#[inline]
-fn push_with(inverse: [f64; 4], a: usize, b: usize, axis: &Axis, f: f64, acc: &mut [f64]) {
-    let [ma, ia, mb, ib] = inverse;
-    let pa = &mut acc[3 * a..3 * a + 3];
-    pa[0] -= ma * f * axis.dir[0];
-    pa[1] -= ma * f * axis.dir[1];
-    pa[2] -= ia * f * axis.arm_a;
-    let pb = &mut acc[3 * b..3 * b + 3];
-    pb[0] += mb * f * axis.dir[0];
-    pb[1] += mb * f * axis.dir[1];
-    pb[2] += ib * f * axis.arm_b;
-}
-
-/// Relative rate along `axis` of body `b` against body `a` in the velocities
-/// (or accelerations) `v`: dir·(v_b − v_a) + ω_b arm_b − ω_a arm_a.
-#[inline]
-pub(super) fn rate(v: &[f64], a: usize, b: usize, axis: &Axis) -> f64 {
-    let va = &v[3 * a..3 * a + 3];
-    let vb = &v[3 * b..3 * b + 3];
-    axis.dir[0] * (vb[0] - va[0]) + axis.dir[1] * (vb[1] - va[1]) + vb[2] * axis.arm_b
-        - va[2] * axis.arm_a
-}
-
-/// Normal rate δ̇ of a row (m/s).
-#[inline]
-pub(super) fn normal_rate(row: &Row, v: &[f64]) -> f64 {
-    rate(v, row.a, row.b, &row.normal)
-}
+use super::data::{normal_rate, push_with, rate, PatchMode, PointMode};
+use super::Integrator;
 
 impl Integrator {
     /// Whether point `i` starting to load must be a switch whatever its

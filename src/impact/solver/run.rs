@@ -18,9 +18,9 @@
 //! stores the energy to rebound faster (docs/model.md §9).
 
 use super::super::{ImpactError, ImpactOutcome, StopReason};
-use super::rhs::normal_rate;
-use super::rk::Rk;
-use super::{Clock, Integrator, PointMode, Variable};
+use super::data::{normal_rate, Clock, PointMode, Variable};
+use super::tableau::Rk;
+use super::Integrator;
 
 /// The step size controller of Hairer, Nørsett and Wanner's DOPRI5 (a
 /// proportional–integral controller, *Solving ODEs I* Sec. II.4 and IV.2):

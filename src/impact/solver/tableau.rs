@@ -1,0 +1,204 @@
+//! The Runge–Kutta pair of the time-domain solver: its tableau, stages,
+//! error estimate and interpolant (stepped on the impact in rk.rs).
+//!
+//! The embedded pair of Dormand and Prince (1980) of orders 5 and 4 with
+//! seven stages, the last evaluated at the new state (first same as last, so
+//! six evaluations per accepted step), and the continuous extension of order
+//! 4 given by Hairer, Nørsett and Wanner (*Solving Ordinary Differential
+//! Equations I*, 2nd ed., Sec. II.6): the state anywhere inside the step from
+//! five coefficient vectors, which the event stage searches for switches.
+
+// Nodes c, coefficients a (the last row: the weights b of order 5) and the
+// error weights b − b̂ (b̂ of order 4) of the Dormand–Prince pair.
+pub(super) const C: [f64; 7] = [0.0, 0.2, 0.3, 0.8, 8.0 / 9.0, 1.0, 1.0];
+const A: [[f64; 6]; 7] = [
+    [0.0; 6],
+    [0.2, 0.0, 0.0, 0.0, 0.0, 0.0],
+    [3.0 / 40.0, 9.0 / 40.0, 0.0, 0.0, 0.0, 0.0],
+    [44.0 / 45.0, -56.0 / 15.0, 32.0 / 9.0, 0.0, 0.0, 0.0],
+    [
+        19372.0 / 6561.0,
+        -25360.0 / 2187.0,
+        64448.0 / 6561.0,
+        -212.0 / 729.0,
+        0.0,
+        0.0,
+    ],
+    [
+        9017.0 / 3168.0,
+        -355.0 / 33.0,
+        46732.0 / 5247.0,
+        49.0 / 176.0,
+        -5103.0 / 18656.0,
+        0.0,
+    ],
+    [
+        35.0 / 384.0,
+        0.0,
+        500.0 / 1113.0,
+        125.0 / 192.0,
+        -2187.0 / 6784.0,
+        11.0 / 84.0,
+    ],
+];
+const E: [f64; 7] = [
+    71.0 / 57600.0,
+    0.0,
+    -71.0 / 16695.0,
+    71.0 / 1920.0,
+    -17253.0 / 339200.0,
+    22.0 / 525.0,
+    -1.0 / 40.0,
+];
+// Dense output weights (Hairer et al., contd5).
+const D: [f64; 7] = [
+    -12715105075.0 / 11282082432.0,
+    0.0,
+    87487479700.0 / 32700410799.0,
+    -10690763975.0 / 1880347072.0,
+    701980252875.0 / 199316789632.0,
+    -1453857185.0 / 822651844.0,
+    69997945.0 / 29380423.0,
+];
+
+/// Stage buffers of one step (all of the state's length).
+#[derive(Debug, Default)]
+pub(super) struct Rk {
+    /// State at the step's start.
+    pub y0: Vec<f64>,
+    /// Stage derivatives k₁ … k₇ (k₇ at the new state).
+    pub(super) k: [Vec<f64>; 7],
+    pub(super) stage: Vec<f64>,
+    /// The local error estimate of the velocities and compressions.
+    pub(super) err: Vec<f64>,
+    /// The new state (order 5).
+    pub y1: Vec<f64>,
+    /// Step length of the last step (s).
+    pub h: f64,
+    /// k₁ holds dy/dt at `y0` (first same as last after an accepted step).
+    pub fresh: bool,
+    /// Interpolant coefficients r₁ … r₅ of the last step, once formed.
+    dense: [Vec<f64>; 5],
+    pub(super) dense_ready: bool,
+}
+
+impl Rk {
+    pub fn resize(&mut self, len: usize) {
+        for v in self.k.iter_mut().chain(self.dense.iter_mut()) {
+            v.resize(len, 0.0);
+        }
+        self.y0.resize(len, 0.0);
+        self.stage.resize(len, 0.0);
+        self.err.resize(len, 0.0);
+        self.y1.resize(len, 0.0);
+        self.fresh = false;
+    }
+
+    /// The step was accepted whole: its end is the next step's start and
+    /// k₇ its first stage.
+    pub fn advance(&mut self) {
+        std::mem::swap(&mut self.y0, &mut self.y1);
+        self.k.swap(0, 6);
+        self.fresh = true;
+    }
+
+    /// A component of the interpolated state at fraction θ ∈ [0, 1].
+    #[inline]
+    pub fn dense_at(&self, j: usize, theta: f64) -> f64 {
+        let r = &self.dense;
+        let s = 1.0 - theta;
+        r[0][j] + theta * (r[1][j] + s * (r[2][j] + theta * (r[3][j] + s * r[4][j])))
+    }
+
+    /// The interpolant's coefficients of a linear functional Σ w_j y_j,
+    /// given as (index, weight) pairs: the functional at θ is
+    /// g₁ + θ (g₂ + (1 − θ)(g₃ + θ (g₄ + (1 − θ) g₅))).
+    pub fn dense_functional(&self, terms: &[(usize, f64)]) -> [f64; 5] {
+        let mut g = [0.0; 5];
+        for &(j, w) in terms {
+            for (m, gm) in g.iter_mut().enumerate() {
+                *gm += w * self.dense[m][j];
+            }
+        }
+        g
+    }
+
+    /// The whole interpolated state at θ into `out`.
+    pub fn dense_state(&self, theta: f64, out: &mut [f64]) {
+        for (j, o) in out.iter_mut().enumerate() {
+            *o = self.dense_at(j, theta);
+        }
+    }
+
+    /// Forms the interpolant of the last step (once per step).
+    pub fn prepare_dense(&mut self) {
+        if self.dense_ready {
+            return;
+        }
+        let h = self.h;
+        let [r1, r2, r3, r4, r5] = &mut self.dense;
+        for j in 0..self.y0.len() {
+            let (y0, y1) = (self.y0[j], self.y1[j]);
+            let diff = y1 - y0;
+            let first = h * self.k[0][j] - diff;
+            r1[j] = y0;
+            r2[j] = diff;
+            r3[j] = first;
+            r4[j] = diff - h * self.k[6][j] - first;
+            let mut d = 0.0;
+            for (s, w) in D.iter().enumerate() {
+                if *w != 0.0 {
+                    d += w * self.k[s][j];
+                }
+            }
+            r5[j] = h * d;
+        }
+        self.dense_ready = true;
+    }
+}
+
+/// y₀ + h Σ_l a_sl k_l over the components of `out`.
+///
+/// Summed stage by stage over contiguous slices (so that the loops
+/// vectorise), each component in the order l = 0, 1, …, s − 1 from 0.0:
+/// the same operations, in the same order, as a sum per component.
+#[inline]
+pub(super) fn stage_state(out: &mut [f64], y0: &[f64], k: &[Vec<f64>; 7], s: usize, h: f64) {
+    let n = out.len();
+    out.fill(0.0);
+    for (kl, &a) in k.iter().zip(&A[s]).take(s) {
+        for (o, &v) in out.iter_mut().zip(&kl[..n]) {
+            *o += a * v;
+        }
+    }
+    for (o, &y) in out.iter_mut().zip(&y0[..n]) {
+        *o = y + h * *o;
+    }
+}
+
+/// h Σ_s (b_s − b̂_s) k_s over the components of `out` (the local error
+/// estimate), summed as [`stage_state`] sums.
+#[inline]
+pub(super) fn error_estimate(out: &mut [f64], k: &[Vec<f64>; 7], h: f64) {
+    let n = out.len();
+    out.fill(0.0);
+    for (ks, &w) in k.iter().zip(&E) {
+        for (o, &v) in out.iter_mut().zip(&ks[..n]) {
+            *o += w * v;
+        }
+    }
+    for o in out.iter_mut() {
+        *o *= h;
+    }
+}
+
+/// Multiplies dy/dt by dt/dx (nothing to do for x = t; a NaN slope makes
+/// the step's error NaN, so that it is rejected).
+#[inline]
+pub(super) fn scale(k: &mut [f64], slope: f64) {
+    if slope != 1.0 {
+        for v in k.iter_mut() {
+            *v *= slope;
+        }
+    }
+}
