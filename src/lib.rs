@@ -37,6 +37,13 @@
 #![allow(clippy::duplicate_mod)]
 #![warn(missing_docs)]
 #![cfg_attr(docsrs, feature(doc_cfg))]
+// The docs link to both Rapier builds and to the sweeps; a build that
+// leaves one of them out (e.g. a game's `bevy` alone, f32 only) keeps those
+// links as text. With every feature (what docs.rs builds) they are checked.
+#![cfg_attr(
+    not(all(feature = "f32", feature = "f64")),
+    allow(rustdoc::broken_intra_doc_links)
+)]
 
 pub mod atomic;
 #[cfg(feature = "bevy")]

@@ -90,16 +90,28 @@ enum RunKind {
     /// The reference engine with this smooth integration and impulse
     /// stepping (`None`: the default, `…:imp:TOL` / `…:imp:fixed`: given).
     Reference(Integrator, Option<StepControl>),
+    /// The Rapier plugin, topple resolving the impacts or native Rapier
+    /// (`response`), with the resolver's settings of a topple run.
     Rapier {
+        response: ImpactResponse,
         dt: f64,
         impulse_step: Option<f64>,
         tolerance: Option<f64>,
         precision: Precision,
     },
-    Native {
-        dt: f64,
-        precision: Precision,
-    },
+}
+
+impl RunKind {
+    /// Native Rapier at step `dt` in build `precision`.
+    fn native(dt: f64, precision: Precision) -> Self {
+        RunKind::Rapier {
+            response: ImpactResponse::Native,
+            dt,
+            impulse_step: None,
+            tolerance: None,
+            precision,
+        }
+    }
 }
 
 fn number(text: &str, what: &str, run: &str) -> anyhow::Result<f64> {
@@ -159,27 +171,27 @@ fn parse_run(run: &str, default: Precision) -> anyhow::Result<RunKind> {
             None,
         ),
         ["rapier", dt, "tol", tol] => RunKind::Rapier {
+            response: ImpactResponse::Topple,
             dt: number(dt, "time step", run)?,
             impulse_step: None,
             tolerance: Some(number(tol, "tolerance", run)?),
             precision,
         },
         ["rapier", dt] => RunKind::Rapier {
+            response: ImpactResponse::Topple,
             dt: number(dt, "time step", run)?,
             impulse_step: None,
             tolerance: None,
             precision,
         },
         ["rapier", dt, step] => RunKind::Rapier {
+            response: ImpactResponse::Topple,
             dt: number(dt, "time step", run)?,
             impulse_step: Some(number(step, "impulse step", run)?),
             tolerance: None,
             precision,
         },
-        ["native", dt] => RunKind::Native {
-            dt: number(dt, "time step", run)?,
-            precision,
-        },
+        ["native", dt] => RunKind::native(number(dt, "time step", run)?, precision),
         _ => bail!(
             "run {run:?} is not one of reference:paper[:DT], reference:TOL (either may end in :imp:TOL or :imp:fixed), \
              rapier:DT, rapier:DT:STEP, rapier:DT:tol:TOL, native:DT (Rapier runs may end in :f32 or :f64)"
@@ -192,9 +204,7 @@ fn parse_run(run: &str, default: Precision) -> anyhow::Result<RunKind> {
 /// that saved reports of the two builds never mix.
 fn full_name(run: &str, kind: &RunKind) -> String {
     match kind {
-        RunKind::Rapier { precision, .. } | RunKind::Native { precision, .. }
-            if !(run.ends_with(":f32") || run.ends_with(":f64")) =>
-        {
+        RunKind::Rapier { precision, .. } if !(run.ends_with(":f32") || run.ends_with(":f64")) => {
             format!("{run}:{}", precision.name())
         }
         _ => run.to_string(),
@@ -264,20 +274,12 @@ fn execute_with(
             settings: reference_settings(kind, args).expect("a reference run"),
         }),
         RunKind::Rapier {
+            response,
             dt,
             impulse_step,
             tolerance,
             precision,
-        } => Box::new(rapier(
-            ImpactResponse::Topple,
-            dt,
-            impulse_step,
-            tolerance,
-            precision,
-        )),
-        RunKind::Native { dt, precision } => {
-            Box::new(rapier(ImpactResponse::Native, dt, None, None, precision))
-        }
+        } => Box::new(rapier(response, dt, impulse_step, tolerance, precision)),
     };
     Ok(engine.run(row, &mut progress)?)
 }
@@ -408,8 +410,14 @@ fn family(kind: &RunKind) -> &'static str {
             "reference, adaptive impulse step"
         }
         RunKind::Reference(..) => "reference, impacts in time",
-        RunKind::Rapier { .. } => "Rapier + topple",
-        RunKind::Native { .. } => "native Rapier",
+        RunKind::Rapier {
+            response: ImpactResponse::Topple,
+            ..
+        } => "Rapier + topple",
+        RunKind::Rapier {
+            response: ImpactResponse::Native,
+            ..
+        } => "native Rapier",
     }
 }
 
@@ -485,7 +493,7 @@ fn front_speed(r: &ChainReport, row: &RowSpec) -> Option<f64> {
 /// Rapier time step of a run, if it is a Rapier run.
 fn rapier_dt(kind: &RunKind) -> Option<f64> {
     match *kind {
-        RunKind::Rapier { dt, .. } | RunKind::Native { dt, .. } => Some(dt),
+        RunKind::Rapier { dt, .. } => Some(dt),
         RunKind::Reference(..) => None,
     }
 }
@@ -525,19 +533,26 @@ fn print_table(
             1e3 * r.run_time / steps
         });
         let precision = match *kind {
-            RunKind::Rapier { precision, .. } | RunKind::Native { precision, .. } => precision,
+            RunKind::Rapier { precision, .. } => precision,
             RunKind::Reference(..) => Precision::F64,
         };
         let native_ms = rapier_dt(kind).and_then(|dt| {
             kinds
                 .iter()
                 .zip(reports)
-                .find(|((_, k2), _)| *k2 == RunKind::Native { dt, precision })
+                .find(|((_, k2), _)| *k2 == RunKind::native(dt, precision))
                 .map(|(_, r2)| 1e3 * r2.run_time / (r2.simulated_time / dt).round().max(1.0))
         });
         let ratio = match (kind, ms_per_step, native_ms) {
+            (
+                RunKind::Rapier {
+                    response: ImpactResponse::Native,
+                    ..
+                },
+                _,
+                _,
+            ) => "1".into(),
             (RunKind::Rapier { .. }, Some(a), Some(b)) => format!("{:.2}", a / b),
-            (RunKind::Native { .. }, _, _) => "1".into(),
             _ => "-".into(),
         };
         let relative = |v: Option<f64>, b: Option<f64>| match (v, b) {
@@ -605,6 +620,7 @@ mod tests {
         assert_eq!(
             parse_run("rapier:1e-3:1e-4", Precision::F64).unwrap(),
             RunKind::Rapier {
+                response: ImpactResponse::Topple,
                 dt: 1e-3,
                 impulse_step: Some(1e-4),
                 tolerance: None,
@@ -613,21 +629,16 @@ mod tests {
         );
         assert_eq!(
             parse_run("native:5e-4", Precision::F32).unwrap(),
-            RunKind::Native {
-                dt: 5e-4,
-                precision: Precision::F32
-            }
+            RunKind::native(5e-4, Precision::F32)
         );
         assert_eq!(
             parse_run("native:5e-4:f64", Precision::F32).unwrap(),
-            RunKind::Native {
-                dt: 5e-4,
-                precision: Precision::F64
-            }
+            RunKind::native(5e-4, Precision::F64)
         );
         assert_eq!(
             parse_run("rapier:1e-3", Precision::F64).unwrap(),
             RunKind::Rapier {
+                response: ImpactResponse::Topple,
                 dt: 1e-3,
                 impulse_step: None,
                 tolerance: None,

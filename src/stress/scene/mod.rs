@@ -205,7 +205,7 @@ fn describe(c: &SceneCombo, o: &SceneObservation) -> String {
 
 /// What a scene sweep found.
 #[derive(Clone, Debug, Default)]
-pub struct SceneResult {
+pub struct SceneSweepReport {
     /// Runs per engine.
     pub runs: BTreeMap<SceneEngine, usize>,
     /// Impacts checked.
@@ -272,7 +272,7 @@ impl Coverage {
     }
 }
 
-impl SceneResult {
+impl SceneSweepReport {
     /// The violations of topple's engines: what the exit status counts.
     pub fn counted(&self) -> impl Iterator<Item = &Violation> {
         self.violations.iter().filter(|v| !v.engine.is_baseline())
@@ -290,7 +290,7 @@ pub fn scene_sweep(
     spec: &SceneSpec,
     which: Option<usize>,
     progress: impl Fn(&SceneCombo, &SceneObservation) + Sync,
-) -> SceneResult {
+) -> SceneSweepReport {
     let indices: Vec<usize> = match which {
         Some(i) => vec![i],
         None => (0..spec.scenes).collect(),
@@ -304,7 +304,7 @@ pub fn scene_sweep(
             (c, o)
         })
         .collect();
-    let mut r = SceneResult::default();
+    let mut r = SceneSweepReport::default();
     for (c, o) in &observed {
         *r.runs.entry(c.engine).or_default() += 1;
         r.impacts += o.audit.impacts;
@@ -350,7 +350,7 @@ const SCENE_KINDS: [Kind; 9] = [
 ];
 
 /// The table of a scene sweep (plain text).
-pub fn scene_table(spec: &SceneSpec, r: &SceneResult) -> String {
+pub fn scene_table(spec: &SceneSpec, r: &SceneSweepReport) -> String {
     use std::fmt::Write;
     let mut s = String::new();
     let total: usize = r.runs.values().sum();
