@@ -81,3 +81,85 @@ fn small_slip_stops_and_then_sticks() {
     assert!(slip_after.abs() < 1e-9);
     assert!(out.contacts[0].tangent_impulse.abs() <= 0.4 * out.contacts[0].normal_impulse + 1e-12);
 }
+
+/// A block of an ideal Domino T row struck near its top while it stands on
+/// the two corners of its foot (the first impact of the row in the Rapier
+/// plugin, cut down to the two blocks): the foot's corner starts a rounding
+/// into the ground (7·10⁻⁸ m) with its friction patch idle, then loads from
+/// rest while it slides. Its friction must act from the first of its load:
+/// the time-domain resolver converged (10⁻¹⁰) and the paper's impulse
+/// stepping (adaptive, 10⁻⁷, a different integrator of the same law) give
+/// the same answer to 10⁻⁶ of the speed. Before the onset of such a point
+/// was a switch they were 7·10⁻⁴ apart: the corner took its first 1.7 % of
+/// normal impulse without friction.
+#[test]
+fn friction_acts_from_the_first_load_of_a_point_that_starts_at_zero() {
+    let bodies = [
+        Body::new(1.0, 0.000_541_013_333_333_333_4)
+            .with_position([0.242_183_460_192_645_83, 0.037_506_287_042_613_43])
+            .with_velocity([0.550_895_333_742_177_4, -0.270_916_771_990_913_46])
+            .with_angular_velocity(-22.883_503_958_458_288),
+        Body::new(1.0, 0.000_541_013_333_333_333_4)
+            .with_position([0.2736, 0.039_999_859_444_122_6]),
+    ];
+    let between = ContactMaterial {
+        stiffness: 2.3e8,
+        exponent: 1.5,
+        restitution: 0.0,
+        friction: 0.0,
+        stick_friction: 0.0,
+    };
+    let ground = ContactMaterial {
+        stiffness: 6.9e8,
+        exponent: 1.5,
+        restitution: 0.0,
+        friction: 0.45,
+        stick_friction: 0.9,
+    };
+    let contacts = [
+        Contact::new(
+            [Some(0), Some(1)],
+            [0.2688, 0.067_748_638_725_312_87],
+            [1.0, 0.0],
+            between,
+        ),
+        Contact::new(
+            [Some(1), None],
+            [0.2688, -7.027_793_870_809_096e-8],
+            [0.0, -1.0],
+            ground,
+        ),
+        Contact::new(
+            [Some(1), None],
+            [0.2784, -7.027_793_869_421_317e-8],
+            [0.0, -1.0],
+            ground,
+        ),
+    ];
+    let mut solver = ImpactSolver::new();
+    let in_time = solver
+        .solve(&bodies, &contacts, &ImpactSettings::adaptive(1e-10))
+        .unwrap();
+    let in_impulse = solver
+        .solve(&bodies, &contacts, &ImpactSettings::adaptive_impulse(1e-7))
+        .unwrap();
+    let speed = bodies[0].velocity[0].hypot(bodies[0].velocity[1]);
+    let rho = (bodies[1].inertia / bodies[1].mass).sqrt();
+    let worst = in_time
+        .bodies
+        .iter()
+        .zip(&in_impulse.bodies)
+        .map(|(a, b)| {
+            (a.velocity[0] - b.velocity[0])
+                .abs()
+                .max((a.velocity[1] - b.velocity[1]).abs())
+                .max(rho * (a.angular_velocity - b.angular_velocity).abs())
+        })
+        .fold(0.0, f64::max);
+    assert!(worst < 1e-6 * speed, "{:.2e} of the speed", worst / speed);
+    // the corner that loads slides all through: P_t = μ P_n
+    let corner = in_time.contacts[2];
+    assert!(corner.normal_impulse > 0.0);
+    let ratio = corner.tangent_impulse.abs() / corner.normal_impulse;
+    assert!((ratio - 0.45).abs() < 1e-6, "P_t / P_n = {ratio}");
+}

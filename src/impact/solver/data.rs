@@ -236,8 +236,14 @@ pub(super) struct PointState {
     pub(super) held_force: f64,
     /// Largest compression reached (m).
     pub(super) peak: f64,
-    /// q ≤ 0 at the start of the present step (an onset is watched).
+    /// q ≤ 0 at the start of the present step, or within the rounding of
+    /// zero while a patch waits for its load (an onset is watched).
     pub(super) open: bool,
+    /// The compression at which the onset of an open point is a switch:
+    /// 0 for a gap, the rounding of zero (`Row::q_zero`) for a point that
+    /// starts the step within it, where it does not carry load yet
+    /// (modes.rs, `carries_load`) (m).
+    pub(super) close_at: f64,
     /// An e = 0 point whose energy has just been lost after a load cycle
     /// short enough to be held closed from now on (see
     /// [`ImpactSettings::fast_cycle`]).

@@ -137,7 +137,7 @@ impl Integrator {
                             };
                             out[1] = Some(Watch::both(
                                 Switch::Closes(i),
-                                (q, 1.0, 0.0),
+                                (q, 1.0, point.close_at),
                                 (rate, -1.0, fast),
                             ));
                         }

@@ -145,7 +145,7 @@ impl Integrator {
             PointMode::Compress => {
                 (rate > thr && q > row.q_load)
                     || (point.open
-                        && q > 0.0
+                        && q > point.close_at
                         && (rate < -self.scales.onset || self.onset_matters(i)))
             }
             PointMode::Expand => rate < -thr || q < -row.q_zero,

@@ -43,9 +43,11 @@ impl Integrator {
         let lay = self.layout;
         for i in 0..self.points.len() {
             let q0 = rk.y0[lay.q(i)];
+            let q_zero = self.rows[i].q_zero;
             let open = self.points[i].mode == PointMode::Compress
-                && (q0 < 0.0 || (q0 == 0.0 && !self.loads_from_rest(i, &rk.y0)));
+                && (q0 < 0.0 || (q0 <= q_zero && !self.loads_from_rest(i, &rk.y0)));
             self.points[i].open = open;
+            self.points[i].close_at = if q0 > 0.0 { q_zero } else { 0.0 };
         }
         if !rk.fresh {
             let (y0, k) = (&rk.y0, &mut rk.k[0]);
