@@ -31,6 +31,7 @@ pub mod audit;
 mod body;
 pub mod capture;
 pub(crate) mod contact;
+pub(crate) mod dormand_prince;
 mod error;
 mod impulse;
 mod outcome;

@@ -1,14 +1,17 @@
 //! Explicit Runge–Kutta steps for the smooth phase with the contact mode held
 //! fixed: the paper's improved Euler (Heun, order 2; Sec. 3.1) and the
 //! Dormand–Prince 5(4) pair with an embedded error estimate (Dormand & Prince
-//! 1980; the coefficients are the published ones).
+//! 1980; the coefficients in `impact/dormand_prince.rs`).
+
+use crate::impact::dormand_prince as dp;
 
 /// A Butcher tableau.
 pub(crate) struct Tableau {
     /// Stage nodes c_i.
     pub c: &'static [f64],
-    /// Lower-triangular a_ij, row i holds the i coefficients of stage i.
-    pub a: &'static [&'static [f64]],
+    /// Lower-triangular a_ij: row i holds the i coefficients of stage i,
+    /// padded with zeros (skipped in the sums).
+    pub a: &'static [[f64; 6]],
     /// Weights of the propagated solution.
     pub b: &'static [f64],
     /// Weights of the error estimate (b − b̂), if the pair has one.
@@ -18,59 +21,18 @@ pub(crate) struct Tableau {
 /// Improved Euler (Heun's method), the paper's integrator.
 pub(crate) const HEUN: Tableau = Tableau {
     c: &[0.0, 1.0],
-    a: &[&[], &[1.0]],
+    a: &[[0.0; 6], [1.0, 0.0, 0.0, 0.0, 0.0, 0.0]],
     b: &[0.5, 0.5],
     e: None,
 };
 
-/// Dormand–Prince 5(4).
+/// Dormand–Prince 5(4), the crate's one definition
+/// (`impact/dormand_prince.rs`).
 pub(crate) const DOPRI5: Tableau = Tableau {
-    c: &[0.0, 0.2, 0.3, 0.8, 8.0 / 9.0, 1.0, 1.0],
-    a: &[
-        &[],
-        &[0.2],
-        &[3.0 / 40.0, 9.0 / 40.0],
-        &[44.0 / 45.0, -56.0 / 15.0, 32.0 / 9.0],
-        &[
-            19372.0 / 6561.0,
-            -25360.0 / 2187.0,
-            64448.0 / 6561.0,
-            -212.0 / 729.0,
-        ],
-        &[
-            9017.0 / 3168.0,
-            -355.0 / 33.0,
-            46732.0 / 5247.0,
-            49.0 / 176.0,
-            -5103.0 / 18656.0,
-        ],
-        &[
-            35.0 / 384.0,
-            0.0,
-            500.0 / 1113.0,
-            125.0 / 192.0,
-            -2187.0 / 6784.0,
-            11.0 / 84.0,
-        ],
-    ],
-    b: &[
-        35.0 / 384.0,
-        0.0,
-        500.0 / 1113.0,
-        125.0 / 192.0,
-        -2187.0 / 6784.0,
-        11.0 / 84.0,
-        0.0,
-    ],
-    e: Some(&[
-        35.0 / 384.0 - 5179.0 / 57600.0,
-        0.0,
-        500.0 / 1113.0 - 7571.0 / 16695.0,
-        125.0 / 192.0 - 393.0 / 640.0,
-        -2187.0 / 6784.0 + 92097.0 / 339200.0,
-        11.0 / 84.0 - 187.0 / 2100.0,
-        -1.0 / 40.0,
-    ]),
+    c: &dp::C,
+    a: &dp::A,
+    b: &dp::B,
+    e: Some(&dp::E),
 };
 
 /// Stage buffers, reused between steps.
@@ -109,10 +71,10 @@ impl Stages {
         self.tmp.resize(n, 0.0);
         self.k[0].copy_from_slice(k0);
         for i in 1..s {
-            let ai = tab.a[i];
+            let ai = &tab.a[i];
             for x in 0..n {
                 let mut acc = 0.0;
-                for (j, aij) in ai.iter().enumerate() {
+                for (j, aij) in ai.iter().enumerate().take(i) {
                     if *aij != 0.0 {
                         acc += aij * self.k[j][x];
                     }
