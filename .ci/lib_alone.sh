@@ -55,10 +55,10 @@ tar xzf "$TARGET_DIR/package/topple-$version.crate" -C "$unpacked"
 # tests run, and clippy -D warnings on everything that build compiles: the
 # library itself (what `cargo clippy --lib` lints), its unit tests and
 # tests/module_graph.rs (a test target that needs the library itself, so
-# cargo builds and lints it; its four checks read the sources, a fraction
-# of a second). Clippy lints while it compiles, as in .ci/run: clippy-driver
-# is the wrapper of the package's rustc calls, and there is no check build
-# of the dependencies beside their build. The three sets share every
+# cargo builds and lints it). Clippy lints while it compiles, as in
+# .ci/run: clippy-driver is the wrapper of the package's rustc calls, and
+# there is no check build of the dependencies beside their build. The three
+# sets share every
 # dependency but the Rapier builds (cargo hack is not installed here: an
 # explicit list; `cli`, `plots`, `scene-files` are covered by the tests'
 # build):
@@ -73,10 +73,17 @@ tar xzf "$TARGET_DIR/package/topple-$version.crate" -C "$unpacked"
 # the other sets.)
 CLIPPY_DRIVER=$(rustup which clippy-driver 2>/dev/null || command -v clippy-driver) \
     || { echo "clippy-driver is missing: rustup component add clippy"; exit 1; }
+# tests/module_graph.rs is built, not run: the tests' run runs it on the
+# repository's sources, and its binary names the directory it was built
+# from (CARGO_MANIFEST_DIR), which is a new temporary one each run while
+# cargo, which hashes a path package without its path, may reuse the binary.
 for set in "" "f32" "f64"; do
     stage "features '$set' alone: the packaged crate builds, linted (clippy -D warnings); its unit tests (cargo test --profile dev --lib)"
+    args=(--locked --profile dev --no-default-features --features "$set"
+          --manifest-path "$unpacked/topple-$version/Cargo.toml")
     RUSTC_WORKSPACE_WRAPPER="$CLIPPY_DRIVER" CLIPPY_ARGS="-D__CLIPPY_HACKERY__warnings__CLIPPY_HACKERY__" \
-        cargo test --locked --profile dev --lib --test module_graph --no-default-features --features "$set" \
-        --manifest-path "$unpacked/topple-$version/Cargo.toml"
+        cargo test "${args[@]}" --lib --test module_graph --no-run
+    RUSTC_WORKSPACE_WRAPPER="$CLIPPY_DRIVER" CLIPPY_ARGS="-D__CLIPPY_HACKERY__warnings__CLIPPY_HACKERY__" \
+        cargo test "${args[@]}" --lib
 done
 stage "done"
