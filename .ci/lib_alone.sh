@@ -5,7 +5,7 @@
 # then, for each feature set that picks code (none, `f32` alone, `f64`
 # alone), the packaged sources built, linted by clippy and their unit tests
 # run. They share no compiled unit with the tests' build (other features of
-# serde, num-traits, nalgebra, rapier …, the dev profile), so .ci/run starts
+# serde, clap, glam, nalgebra …, the dev profile), so .ci/run starts
 # them at the lowest CPU priority (`nice -n 19`, SCHED_IDLE) beside its own
 # stages: they take a core only when the build, the tests' run and the Bevy
 # stage leave one idle. Runs alone as well: `.ci/lib_alone.sh [target
