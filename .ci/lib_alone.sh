@@ -41,7 +41,7 @@ unset RUSTC_WORKSPACE_WRAPPER CLIPPY_ARGS
 export CARGO_PROFILE_DEV_DEBUG=0 CARGO_INCREMENTAL=0
 # No unit test uses proptest or criterion: this cfg leaves them out of the
 # dev-dependencies (Cargo.toml), and with them clap, regex and rand.
-export RUSTFLAGS="--cfg topple_lib_alone"
+export RUSTFLAGS="${RUSTFLAGS:+$RUSTFLAGS }--cfg topple_lib_alone"
 
 stage "cargo package (without default features); the dependency lines of README.md and docs/bevy.md resolve"
 # `--no-verify`: the packaged sources are built and tested below, which is
