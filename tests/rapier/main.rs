@@ -13,6 +13,7 @@ mod game_rate;
 mod shapes;
 mod sleeping;
 mod soak;
+mod soft_contact;
 mod stress_checks;
 mod substeps;
 mod vs_reference;

@@ -469,3 +469,77 @@ fn a_body_native_rapier_also_puts_below_the_ground_is_the_baseline() {
         .iter()
         .any(|v| v.kind == Kind::ThroughGround));
 }
+
+/// Scene 3 of `topple stress --family scenes --quick --seed 4`: an f64
+/// stack with a body dropped on top, whose impacts decide where it lands.
+/// The drawn run is 0.90 of the least width deep against native Rapier's
+/// 0.74; from nearby starts (every x velocity changed by steps of 10⁻⁶ m/s)
+/// topple's depth lies on both sides of native's (measured 0.64–0.90): a
+/// chaotic scene, where one run of each compares two draws. The check reads
+/// topple's shallowest run against native's deepest, so it is not counted.
+/// Scene 30 of seed 1 (an f64 stack whose excess comes with the adapter's
+/// sub-steps, docs/stress.md) is deeper than native from every start (0.670
+/// against 0.439): still counted. And the rule on its own: without nearby
+/// runs one run against one; with them, counted only when every topple run
+/// is deeper than every native one.
+#[test]
+fn a_chaotic_scene_is_judged_from_nearby_starts_a_systematic_excess_still_counts() {
+    use topple::stress::scene::NEARBY_RUNS;
+    use topple::stress::scene::{run_scene_combo, scene_violations, NearbyRuns, SceneSpec};
+    let spec = SceneSpec::quick(1);
+    let penetrates = |c: &_, o: &_| {
+        scene_violations(c, o)
+            .iter()
+            .any(|v| v.kind == Kind::Penetration)
+    };
+
+    let c = SceneSpec::quick(4).draw(3);
+    let o = run_scene_combo(&c, 60.0);
+    let (native, _) = o.native.expect("native ran on the same scene");
+    let near = o.nearby.as_ref().expect("deeper than native: run again");
+    assert_eq!(near.topple.len(), NEARBY_RUNS, "{near:?}");
+    assert_eq!(near.native.len(), NEARBY_RUNS, "{near:?}");
+    assert!(o.penetration > native, "the drawn run is deeper: {o:?}");
+    // nearby starts give depths on both sides of native's deepest
+    let native_deepest = near.native.iter().fold(native, |a, &b| a.max(b));
+    assert!(near.topple.iter().any(|&d| d < native_deepest), "{near:?}");
+    assert!(near.topple.iter().any(|&d| d > native_deepest), "{near:?}");
+    assert!(!penetrates(&c, &o), "{o:?}");
+
+    let c = spec.draw(30);
+    let o = run_scene_combo(&c, 60.0);
+    let near = o.nearby.as_ref().expect("deeper than native: run again");
+    let (native, _) = o.native.unwrap();
+    let native_deepest = near.native.iter().fold(native, |a, &b| a.max(b));
+    assert!(
+        near.topple.iter().all(|&d| d > native_deepest),
+        "deeper from every start: {near:?} against {native_deepest}"
+    );
+    assert!(penetrates(&c, &o), "{o:?}");
+
+    // the rule on hand-made observations of scene 30: topple 0.60 deep,
+    // native 0.44, beyond the tolerance
+    let mut made = o.clone();
+    made.penetration = 0.60;
+    made.native = Some((0.44, false));
+    made.nearby = None;
+    assert!(penetrates(&c, &made), "one run against one");
+    made.nearby = Some(NearbyRuns {
+        topple: vec![0.58, 0.62],
+        native: vec![0.44, 0.45],
+    });
+    assert!(penetrates(&c, &made), "deeper from every start");
+    made.nearby = Some(NearbyRuns {
+        topple: vec![0.58, 0.43],
+        native: vec![0.44, 0.45],
+    });
+    assert!(
+        !penetrates(&c, &made),
+        "a nearby start shallower than native"
+    );
+    made.nearby = Some(NearbyRuns {
+        topple: vec![0.58, 0.62],
+        native: vec![0.44, 0.61],
+    });
+    assert!(!penetrates(&c, &made), "a nearby native start as deep");
+}

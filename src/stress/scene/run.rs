@@ -42,6 +42,10 @@ pub struct SceneObservation {
     /// body went below the ground (also without allowance: counted or
     /// tunnelled).
     pub native: Option<(f64, bool)>,
+    /// The same scene from nearby initial conditions, run only when this
+    /// topple run is deeper than native's beyond the overlap tolerance
+    /// ([`NearbyRuns`]); `None` otherwise.
+    pub nearby: Option<NearbyRuns>,
     /// Largest impact work of one frame: Σ over the frame's impact attempts
     /// of impulse steps (accepted and rejected) × contact points, the unit
     /// of the adapter's budget (`FallbackPolicy::max_work`): the adapter's
@@ -69,6 +73,54 @@ pub struct SceneObservation {
     pub audit: AuditSummary,
     /// The scene could not be built.
     pub error: Option<String>,
+}
+
+/// A scene run again from nearby initial conditions, by topple and by
+/// native Rapier: every body's x velocity changed by `k` · [`NEARBY_STEP`]
+/// metres per second (in the scene's units), k = 1 ..= [`NEARBY_RUNS`].
+/// A stack or pyramid struck by bodies whose impacts decide where they land
+/// is chaotic: one run of topple against one of native compares two draws
+/// of motions that differ from the first impact on. The scene check then
+/// counts a topple overlap only when it is deeper than native's from every
+/// start tried: topple's shallowest depth against native's deepest
+/// (docs/stress.md, "Chaotic scenes").
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct NearbyRuns {
+    /// topple's deepest overlap over the least width, one per nearby start.
+    pub topple: Vec<f64>,
+    /// Native Rapier's, one per nearby start (a start it cannot run is left
+    /// out).
+    pub native: Vec<f64>,
+}
+
+/// How many nearby starts a chaotic-looking scene is run from.
+pub const NEARBY_RUNS: usize = 6;
+
+/// The velocity step between nearby starts (m/s, scaled by the scene's
+/// units per metre): far below anything a game resolves, far above
+/// round-off of the speeds (10⁻¹⁶ of 1 m/s in f64, 10⁻⁷ in f32: the f32
+/// build then rounds it to a step of its own).
+pub const NEARBY_STEP: f64 = 1e-6;
+
+impl SceneObservation {
+    /// topple's depth as the scene check reads it: the run's own, or the
+    /// shallowest of it and its nearby runs when the scene was run again.
+    pub fn topple_depth(&self) -> f64 {
+        self.nearby.as_ref().map_or(self.penetration, |n| {
+            n.topple.iter().fold(self.penetration, |a, &b| a.min(b))
+        })
+    }
+
+    /// Native Rapier's depth as the scene check reads it: its run's, or the
+    /// deepest of it and its nearby runs; `None` without a native run.
+    pub fn native_depth(&self) -> Option<f64> {
+        let (pen, _) = self.native?;
+        Some(
+            self.nearby
+                .as_ref()
+                .map_or(pen, |n| n.native.iter().fold(pen, |a, &b| a.max(b))),
+        )
+    }
 }
 
 /// FNV-1a over 64-bit words.
@@ -135,8 +187,45 @@ pub fn run_scene_combo(c: &SceneCombo, budget: f64) -> SceneObservation {
         // own: both are native Rapier's behaviour on this scene)
         let below = native.through_ground.is_some() || native.tunnelled > 0;
         seen.native = (native.error.is_none()).then_some((native.penetration, below));
+        let deeper = seen.native.is_some_and(|(pen, _)| seen.penetration > pen);
+        if deeper && seen.penetration_excess > super::tolerance::PENETRATION && !seen.over_budget {
+            seen.nearby = Some(nearby_runs(c, budget));
+        }
     }
     seen
+}
+
+/// `c`'s scene from [`NEARBY_RUNS`] nearby starts, by its topple engine and
+/// by native Rapier (overlaps watched, each run within `budget`).
+fn nearby_runs(c: &SceneCombo, budget: f64) -> NearbyRuns {
+    let frames = (c.scene.duration / c.scene.solver.dt).round() as usize;
+    let mut out = NearbyRuns::default();
+    for k in 1..=NEARBY_RUNS {
+        let mut scene = c.scene.clone();
+        let dv = k as f64 * NEARBY_STEP * c.unit;
+        for b in &mut scene.bodies {
+            b.velocity[0] += dv;
+        }
+        for (engine, depths) in [
+            (c.rapier_engine(), &mut out.topple),
+            (ImpactResponse::Native, &mut out.native),
+        ] {
+            let mut hooks = Hooks {
+                watch: true,
+                budget,
+                frames,
+                ..Hooks::default()
+            };
+            let o = match c.precision {
+                Precision::F64 => on_f64::run(&scene, engine, &mut hooks),
+                Precision::F32 => on_f32::run(&scene, engine, &mut hooks),
+            };
+            if o.error.is_none() && !o.over_budget {
+                depths.push(o.penetration);
+            }
+        }
+    }
+    out
 }
 
 /// What a run does besides stepping: how many frames, whether it watches
