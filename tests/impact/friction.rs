@@ -145,17 +145,7 @@ fn friction_acts_from_the_first_load_of_a_point_that_starts_at_zero() {
         .unwrap();
     let speed = bodies[0].velocity[0].hypot(bodies[0].velocity[1]);
     let rho = (bodies[1].inertia / bodies[1].mass).sqrt();
-    let worst = in_time
-        .bodies
-        .iter()
-        .zip(&in_impulse.bodies)
-        .map(|(a, b)| {
-            (a.velocity[0] - b.velocity[0])
-                .abs()
-                .max((a.velocity[1] - b.velocity[1]).abs())
-                .max(rho * (a.angular_velocity - b.angular_velocity).abs())
-        })
-        .fold(0.0, f64::max);
+    let worst = crate::common::velocity_distance(&in_time.bodies, &in_impulse.bodies, rho);
     assert!(worst < 1e-6 * speed, "{:.2e} of the speed", worst / speed);
     // the corner that loads slides all through: P_t = μ P_n
     let corner = in_time.contacts[2];

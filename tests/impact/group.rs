@@ -230,17 +230,7 @@ fn flat_lying_pile_impact_ends_and_matches_the_impulse_stepping() {
             .solve(&bodies, &contacts, &settings)
             .unwrap();
         assert!(out.kinetic_energy_after <= out.kinetic_energy_before);
-        let worst = out
-            .bodies
-            .iter()
-            .zip(&fine.bodies)
-            .map(|(a, b)| {
-                (a.velocity[0] - b.velocity[0])
-                    .abs()
-                    .max((a.velocity[1] - b.velocity[1]).abs())
-                    .max(rho * (a.angular_velocity - b.angular_velocity).abs())
-            })
-            .fold(0.0, f64::max);
+        let worst = crate::common::velocity_distance(&out.bodies, &fine.bodies, rho);
         assert!(
             worst < allowed * speed,
             "{settings:?}: error {:.2e} of the speed",

@@ -145,19 +145,7 @@ impl Fnv {
 pub fn run_scene_combo(c: &SceneCombo, budget: f64) -> SceneObservation {
     let start = Instant::now();
     let cpu = crate::clock::CpuWatch::start();
-    let run = |watch: bool| {
-        let frames = (c.scene.duration / c.scene.solver.dt).round() as usize;
-        let mut hooks = Hooks {
-            watch,
-            budget,
-            frames,
-            ..Hooks::default()
-        };
-        match c.precision {
-            Precision::F64 => on_f64::run(&c.scene, c.rapier_engine(), &mut hooks),
-            Precision::F32 => on_f32::run(&c.scene, c.rapier_engine(), &mut hooks),
-        }
-    };
+    let run = |watch: bool| run_whole(&c.scene, c.rapier_engine(), c.precision, watch, budget);
     audit::start();
     let mut seen = run(true);
     seen.audit = audit::finish();
@@ -170,17 +158,7 @@ pub fn run_scene_combo(c: &SceneCombo, budget: f64) -> SceneObservation {
     seen.cpu = cpu.seconds();
     if c.rapier_engine() != ImpactResponse::Native {
         // the baseline on the same scene (its wall time is not the run's)
-        let frames = (c.scene.duration / c.scene.solver.dt).round() as usize;
-        let mut hooks = Hooks {
-            watch: true,
-            budget,
-            frames,
-            ..Hooks::default()
-        };
-        let native = match c.precision {
-            Precision::F64 => on_f64::run(&c.scene, ImpactResponse::Native, &mut hooks),
-            Precision::F32 => on_f32::run(&c.scene, ImpactResponse::Native, &mut hooks),
-        };
+        let native = run_whole(&c.scene, ImpactResponse::Native, c.precision, true, budget);
         // native's depth and its bodies below the ground without its
         // allowance: a centre below the ground counts whatever its speed
         // (topple's run gets the allowance, the baseline does not excuse its
@@ -198,7 +176,6 @@ pub fn run_scene_combo(c: &SceneCombo, budget: f64) -> SceneObservation {
 /// `c`'s scene from [`NEARBY_RUNS`] nearby starts, by its topple engine and
 /// by native Rapier (overlaps watched, each run within `budget`).
 fn nearby_runs(c: &SceneCombo, budget: f64) -> NearbyRuns {
-    let frames = (c.scene.duration / c.scene.solver.dt).round() as usize;
     let mut out = NearbyRuns::default();
     for k in 1..=NEARBY_RUNS {
         let mut scene = c.scene.clone();
@@ -210,22 +187,35 @@ fn nearby_runs(c: &SceneCombo, budget: f64) -> NearbyRuns {
             (c.rapier_engine(), &mut out.topple),
             (ImpactResponse::Native, &mut out.native),
         ] {
-            let mut hooks = Hooks {
-                watch: true,
-                budget,
-                frames,
-                ..Hooks::default()
-            };
-            let o = match c.precision {
-                Precision::F64 => on_f64::run(&scene, engine, &mut hooks),
-                Precision::F32 => on_f32::run(&scene, engine, &mut hooks),
-            };
+            let o = run_whole(&scene, engine, c.precision, true, budget);
             if o.error.is_none() && !o.over_budget {
                 depths.push(o.penetration);
             }
         }
     }
     out
+}
+
+/// `scene` run for its whole duration with `engine` on `precision`'s build,
+/// its overlaps watched every frame if `watch`, within `budget` (s of CPU
+/// time of the thread that runs it).
+fn run_whole(
+    scene: &Scene,
+    engine: ImpactResponse,
+    precision: Precision,
+    watch: bool,
+    budget: f64,
+) -> SceneObservation {
+    let mut hooks = Hooks {
+        watch,
+        budget,
+        frames: (scene.duration / scene.solver.dt).round() as usize,
+        ..Hooks::default()
+    };
+    match precision {
+        Precision::F64 => on_f64::run(scene, engine, &mut hooks),
+        Precision::F32 => on_f32::run(scene, engine, &mut hooks),
+    }
 }
 
 /// What a run does besides stepping: how many frames, whether it watches
