@@ -198,6 +198,34 @@ impl RowConst {
 }
 
 #[inline]
+/// The stuck contacts among `pulled` (indices into `active`) that slip at
+/// all and may (μ_s finite) become sliding, along their slip v_t, or
+/// frictionless where μ = 0 ([`Dynamics::project`]). Returns whether any did.
+fn release_sticks(rc: &RowConst, view: &View, active: &mut [Active], pulled: &[usize]) -> bool {
+    let mut released = false;
+    for &c in pulled {
+        let a = &mut active[c];
+        let (mu, mus) = rc.mu(a.slot);
+        if a.mode != Mode::Stick || !mus.is_finite() {
+            continue;
+        }
+        let Some(g) = rc.geom(view, a.block, a.slot) else {
+            continue;
+        };
+        let vt = rc.kin(view, &g).vt;
+        if vt == 0.0 {
+            continue;
+        }
+        a.mode = if mu > 0.0 {
+            Mode::Slide(vt.signum())
+        } else {
+            Mode::Frictionless
+        };
+        released = true;
+    }
+    released
+}
+
 fn dot3(a: [f64; 3], b: [f64; 3]) -> f64 {
     a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
 }
@@ -410,7 +438,13 @@ impl Dynamics {
     /// M, so the change is the smallest in kinetic-energy norm). The velocity
     /// projection is unilateral: a contact that would have to be pulled
     /// harder than a contact separating at `v_tol` (m/s) is separating; it is
-    /// removed from `active` and the projection repeated. Works on `y` in place.
+    /// removed from `active` and the projection repeated. A stuck contact
+    /// that would be pulled so is first let slide (its mode becomes
+    /// [`Mode::Slide`] along its slip, [`Mode::Frictionless`] without
+    /// sliding friction) where it slips at all and can (μ_s finite), and the
+    /// projection repeated: the tangential impulse of a stick row needs a
+    /// normal impulse to bound it (|P_t| ≤ μ_s P_n), and a pull leaves it
+    /// none. Works on `y` in place; returns whether `active` changed.
     pub fn project(
         &mut self,
         rc: &RowConst,
@@ -420,11 +454,12 @@ impl Dynamics {
         pos: &[[f64; 3]],
         active: &mut Vec<Active>,
         v_tol: f64,
-    ) {
+    ) -> bool {
         // buffers kept between calls: this runs every step
         let mut y0 = std::mem::take(&mut self.proj_start);
         let mut owner = std::mem::take(&mut self.proj_owner);
         let mut drop = std::mem::take(&mut self.proj_drop);
+        let mut changed = false;
         'passes: for pass in 0..2 {
             let mut rounds = 0;
             loop {
@@ -496,6 +531,13 @@ impl Dynamics {
                     if !drop.is_empty() {
                         drop.sort_unstable();
                         drop.dedup();
+                        changed = true;
+                        // a stuck contact that would be pulled first lets
+                        // its slip go: the stick row asks for a tangential
+                        // impulse with no normal impulse to bound it
+                        if release_sticks(rc, &View { lo, hi, y, pos }, active, &drop) {
+                            continue;
+                        }
                         for &c in drop.iter().rev() {
                             active.remove(c);
                         }
@@ -519,6 +561,7 @@ impl Dynamics {
         self.proj_start = y0;
         self.proj_owner = owner;
         self.proj_drop = drop;
+        changed
     }
 
     /// The contact forces of every candidate (block, slot, v_t) by

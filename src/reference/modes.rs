@@ -314,8 +314,13 @@ pub(crate) fn select(
         let pulling = (0..out.len())
             .filter(|&k| dyn_.fn_[k] < -tol.force)
             .min_by(|&a, &b| dyn_.fn_[a].total_cmp(&dyn_.fn_[b]));
-        if let Some(k) = pulling {
+        if let Some(k) = pulling.filter(|&k| !can_slide(rc, &out[k])) {
             out.remove(k);
+        } else if let Some(k) = pulling {
+            // a stuck contact that pulls slides first: its stick row may be
+            // what pulls it (two corners of one block stuck on one face
+            // ask for a tangential force the normal one cannot bound)
+            out[k].mode = slide_against(rc, out[k].slot, dyn_.ft[k]);
         } else {
             let excess = |k: usize| rc.stick_excess(out[k].slot, dyn_.ft[k], dyn_.fn_[k]);
             let Some(k) = (0..out.len())
@@ -324,16 +329,28 @@ pub(crate) fn select(
             else {
                 break;
             };
-            let (mu, _) = rc.mu(out[k].slot);
-            out[k].mode = if mu > 0.0 {
-                Mode::Slide(-dyn_.ft[k].signum())
-            } else {
-                Mode::Frictionless
-            };
+            out[k].mode = slide_against(rc, out[k].slot, dyn_.ft[k]);
         }
         if !dyn_.forces(rc, view, out) {
             break;
         }
     }
     false
+}
+
+/// Whether a pressing contact in [`Mode::Stick`] may slide instead (μ_s
+/// finite: not a no-slip ground).
+fn can_slide(rc: &RowConst, a: &Active) -> bool {
+    a.mode == Mode::Stick && rc.mu(a.slot).1.is_finite()
+}
+
+/// The sliding mode of a contact whose stuck friction force was `ft` (N):
+/// sliding against it, F_t = −dir μ F_n with dir = −sgn F_t; frictionless
+/// where μ = 0.
+fn slide_against(rc: &RowConst, slot: usize, ft: f64) -> Mode {
+    if rc.mu(slot).0 > 0.0 {
+        Mode::Slide(-ft.signum())
+    } else {
+        Mode::Frictionless
+    }
 }

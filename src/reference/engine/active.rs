@@ -102,8 +102,7 @@ impl Engine {
         let mut act = std::mem::take(&mut self.new_active);
         act.clear();
         act.extend_from_slice(&self.active);
-        let n_before = act.len();
-        self.dynamics.project(
+        let changed = self.dynamics.project(
             &self.rc,
             lo,
             hi,
@@ -113,7 +112,7 @@ impl Engine {
             self.v_tol,
         );
         self.new_active = act;
-        if self.new_active.len() != n_before {
+        if changed {
             self.set_active();
         }
         let after = self.window_energy();
