@@ -74,6 +74,11 @@ pub struct Observation {
     /// [`Observation::fallen_rock_back`] on the same row (`None` if it could
     /// not be run).
     pub reference_rock_back: Option<f64>,
+    /// For a topple Rapier run whose fallen count dropped where the
+    /// reference does not explain it: native Rapier of the same build on the
+    /// same row, perturbation and step, as (its [`Observation::fallen_drop`],
+    /// its [`Observation::stood_up_rock_back`] in rad); `None` if not run.
+    pub native_drop: Option<(usize, f64)>,
     /// Fallen blocks (1-based) that came back below [`FALLEN_TILT`], in the
     /// order they first did.
     pub stood_up: Vec<usize>,

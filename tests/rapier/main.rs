@@ -9,6 +9,7 @@ mod cradle;
 mod determinism;
 mod dominoes;
 mod drop;
+mod fallen_baseline;
 mod game_rate;
 mod shapes;
 mod sleeping;
