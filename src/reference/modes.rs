@@ -318,8 +318,9 @@ pub(crate) fn select(
             out.remove(k);
         } else if let Some(k) = pulling {
             // a stuck contact that pulls slides first: its stick row may be
-            // what pulls it (two corners of one block stuck on one face
-            // ask for a tangential force the normal one cannot bound)
+            // what pulls it (a stuck set can be nearly singular, its
+            // forces far beyond the weights), and a stuck contact's
+            // friction needs a normal force to bound it
             out[k].mode = slide_against(rc, out[k].slot, dyn_.ft[k]);
         } else {
             let excess = |k: usize| rc.stick_excess(out[k].slot, dyn_.ft[k], dyn_.fn_[k]);
