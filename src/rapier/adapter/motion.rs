@@ -341,11 +341,9 @@ impl Cadence {
         threshold: f64,
     ) {
         let Some(rb) = bodies.get(h) else { return };
+        // a body met twice (awake and struck) has `extra` already
         let own = rb.additional_solver_iterations();
         if !rb.is_dynamic() || own >= extra || turning_speed(rb, colliders) <= threshold {
-            return;
-        }
-        if self.raised.iter().any(|&(r, _)| r == h) {
             return;
         }
         if let Some(rb) = bodies.get_mut(h) {
