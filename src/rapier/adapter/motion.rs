@@ -8,6 +8,9 @@
 //! to a new pose at the end of the step. A body that did not move (asleep,
 //! fixed, kinematic) keeps its pose. All values are f64 (m, rad, s), read
 //! from Rapier in either precision.
+//!
+//! [`Cadence`] sets how finely Rapier solves the bodies inside the pieces
+//! of a step.
 
 use super::backend::math::Real;
 use super::backend::prelude::{
@@ -265,7 +268,8 @@ impl Motion {
 /// Rapier's soft contacts at the shorter substep (docs/stress.md, "Rapier's
 /// soft contact at a shorter step"). So a piece is solved in
 /// [`Cadence::piece_iterations`] substeps, native Rapier's substep Δt / N,
-/// while the bodies that turn faster than the impact threshold (a leaning,
+/// while the bodies that turn faster than [`Cadence::TURNING_SHARE`] of the
+/// impact threshold (a leaning,
 /// pivoting domino and whatever touches it: Rapier substeps a connected
 /// component at the count of its most demanding body) keep N substeps per
 /// piece through Rapier's per-body `additional_solver_iterations`, the
