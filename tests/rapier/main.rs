@@ -4,6 +4,7 @@
 //! was a test binary of its own and keeps its tests and tolerances.
 
 mod budget;
+mod cadence;
 mod costs;
 mod cradle;
 mod determinism;

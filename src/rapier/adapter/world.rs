@@ -13,6 +13,7 @@ use super::backend::prelude::{
 };
 
 use super::hooks::{ChainedHooks, ToppleHooks};
+use super::motion::Cadence;
 use super::pass::{ImpactContact, ImpactEvent, ImpactPass, Prediction, World};
 use super::scale;
 use super::support::{self, Notice};
@@ -126,6 +127,8 @@ pub struct ToppleRapier {
     fresh: Vec<ColliderHandle>,
     /// Their bodies, recorded at every split of the step they join in.
     added: Vec<RigidBodyHandle>,
+    /// Rapier's substep inside the pieces of a step.
+    cadence: Cadence,
 }
 
 impl ToppleRapier {
@@ -151,6 +154,7 @@ impl ToppleRapier {
             stats: ToppleStats::default(),
             fresh: Vec::new(),
             added: Vec::new(),
+            cadence: Cadence::default(),
         };
         topple.set_settings(settings);
         topple
@@ -346,6 +350,7 @@ impl ToppleRapier {
                 }
             };
             params.dt = end - now;
+            params.num_solver_iterations = self.piece_cadence(&mut parts, params.dt);
             self.stats.rapier_steps += 1;
             let hooks = ChainedHooks {
                 topple: &self.hooks,
@@ -373,6 +378,8 @@ impl ToppleRapier {
                 &params,
                 f64::from(now),
             );
+            let struck = self.pass.motion.changed().map(|(h, _)| h);
+            self.cadence.note_struck(struck);
             now = end;
             if now >= dt || params.dt <= 0.0 {
                 break;
@@ -384,8 +391,28 @@ impl ToppleRapier {
                 splits = 0;
             }
         }
+        self.cadence.restore(parts.bodies);
         self.finish_step();
         groups
+    }
+
+    /// Rapier's substeps for a piece of `piece` (s) of the step: native
+    /// Rapier's substep, with the bodies that turn fast kept at the frame's
+    /// count per piece ([`Cadence`]).
+    fn piece_cadence(&mut self, parts: &mut StepParts<'_>, piece: Real) -> usize {
+        let frame = parts.integration_parameters;
+        let n = frame.num_solver_iterations;
+        let kept = Cadence::piece_iterations(n, f64::from(piece), f64::from(frame.dt));
+        self.cadence.begin_piece(
+            parts.islands,
+            &self.added,
+            parts.bodies,
+            parts.colliders,
+            n,
+            kept,
+            Cadence::TURNING_SHARE * self.effective.min_approach_speed,
+        );
+        kept
     }
 
     /// How many equal sub-steps a step of `dt` (s) may take
