@@ -22,7 +22,6 @@
 use topple::coupling::{PairMaterial, ToppleSettings};
 use topple::impact::ContactMaterial;
 use topple::rapier::f64::ToppleRapier;
-use topple::rapier2d_f64::parry::query;
 use topple::rapier2d_f64::prelude::*;
 
 const HALF: f64 = 0.05; // m, half side of a box
@@ -106,14 +105,8 @@ fn run(mut topple: ToppleRapier, per_frame: usize, iterations: usize) -> Run {
                 out.stack_impacts += 1;
             }
         }
-        for pair in colliders.windows(2) {
-            let (a, b) = (&world.colliders[pair[0]], &world.colliders[pair[1]]);
-            let c = query::contact(a.position(), a.shape(), b.position(), b.shape(), 0.0)
-                .expect("boxes and the ground have a contact query");
-            if let Some(c) = c {
-                out.deepest = out.deepest.max(-c.dist);
-            }
-        }
+        let deepest = super::overlap::deepest_in_column(&world.colliders, &colliders);
+        out.deepest = out.deepest.max(deepest);
     }
     out.rapier_steps = topple.stats().rapier_steps;
     out
