@@ -69,21 +69,9 @@ fn run(mut topple: ToppleRapier, per_frame: usize, iterations: usize) -> Run {
         ColliderBuilder::cuboid(20.0, 0.5),
     );
     topple.manage(&mut world.colliders, ground, wood);
-    let mut stack = Vec::new();
-    let mut colliders = vec![ground];
-    for k in 0..LEVELS {
-        // masses 2^(k−2) kg, the heaviest on top, each box resting on
-        // the one below, off centre by 2 % of its side
-        let density = 2f64.powi(k as i32 - 2) / (2.0 * HALF).powi(2);
-        let x = 0.002 * if k % 2 == 0 { 1.0 } else { -1.0 };
-        let (b, c) = world.insert(
-            RigidBodyBuilder::dynamic().translation(Vector::new(x, HALF * (2 * k + 1) as f64)),
-            ColliderBuilder::cuboid(HALF, HALF).density(density),
-        );
-        topple.manage(&mut world.colliders, c, wood);
-        stack.push(b);
-        colliders.push(c);
-    }
+    // masses 2^(k−2) kg, the heaviest on top
+    let (stack, colliders) =
+        super::stack::column(&mut world, &mut topple, ground, wood, (HALF, LEVELS, 2.0));
     // the slider, 1 kg, from 9 m to the left of the stack at 4 m/s: 8 m in
     // the run, so that it never reaches the stack
     let (_, slider) = world.insert(
@@ -100,12 +88,8 @@ fn run(mut topple: ToppleRapier, per_frame: usize, iterations: usize) -> Run {
     };
     for _ in 0..FRAMES * per_frame {
         topple.step(&mut world);
-        for e in topple.last_events() {
-            if topple.event_bodies(e).iter().any(|b| stack.contains(b)) {
-                out.stack_impacts += 1;
-            }
-        }
-        let deepest = super::overlap::deepest_in_column(&world.colliders, &colliders);
+        out.stack_impacts += super::stack::stack_impacts(&topple, &stack);
+        let deepest = super::stack::deepest_in_column(&world.colliders, &colliders);
         out.deepest = out.deepest.max(deepest);
     }
     out.rapier_steps = topple.stats().rapier_steps;

@@ -70,22 +70,9 @@ fn run_with(topple_mode: bool, ratio: f64, levels: usize, ball_e: f64) -> Run {
         ColliderBuilder::cuboid(5.0, 0.5),
     );
     topple.manage(&mut world.colliders, ground, wood);
-    let mut stack = Vec::new();
-    let mut colliders = vec![ground];
-    for k in 0..levels {
-        // masses ratio^(k−2) kg, the heaviest on top; each box on the one
-        // below, off centre by 2 % of its side
-        let density = ratio.powi(k as i32 - 2) / (2.0 * HALF).powi(2);
-        let y = HALF * (2 * k + 1) as f64;
-        let x = 0.002 * if k % 2 == 0 { 1.0 } else { -1.0 };
-        let (b, c) = world.insert(
-            RigidBodyBuilder::dynamic().translation(Vector::new(x, y)),
-            ColliderBuilder::cuboid(HALF, HALF).density(density),
-        );
-        topple.manage(&mut world.colliders, c, wood);
-        stack.push(b);
-        colliders.push(c);
-    }
+    // masses ratio^(k−2) kg, the heaviest on top
+    let (stack, colliders) =
+        super::stack::column(&mut world, &mut topple, ground, wood, (HALF, levels, ratio));
     // the ball that keeps topple sub-stepping and splitting, 1 m away
     let (_, ball) = world.insert(
         RigidBodyBuilder::dynamic().translation(Vector::new(1.0, 0.6)),
@@ -101,12 +88,8 @@ fn run_with(topple_mode: bool, ratio: f64, levels: usize, ball_e: f64) -> Run {
     for _ in 0..FRAMES {
         topple.step(&mut world);
         out.impacts += topple.last_impacts().len();
-        for e in topple.last_events() {
-            if topple.event_bodies(e).iter().any(|b| stack.contains(b)) {
-                out.stack_impacts += 1;
-            }
-        }
-        let deepest = super::overlap::deepest_in_column(&world.colliders, &colliders);
+        out.stack_impacts += super::stack::stack_impacts(&topple, &stack);
+        let deepest = super::stack::deepest_in_column(&world.colliders, &colliders);
         out.deepest = out.deepest.max(deepest);
     }
     out.rapier_steps = topple.stats().rapier_steps;

@@ -1,0 +1,61 @@
+//! A column of boxes on the ground for the stepping tests (cadence, warm
+//! start): built the same way, watched the same way, the deepest overlap
+//! measured with parry's own contact query (independent of topple's pass
+//! and of Rapier's solver).
+
+use topple::coupling::MaterialId;
+use topple::rapier::f64::ToppleRapier;
+use topple::rapier2d_f64::parry::query;
+use topple::rapier2d_f64::prelude::*;
+
+/// A column of `levels` square boxes of half side `half` (m) on the ground
+/// collider `ground`, of masses ratio^(k−2) kg from the bottom (k = 0) up,
+/// each resting on the one below, off centre by 2 % of its side either
+/// way, managed with `material`. Returns the bodies and the colliders, the
+/// ground first.
+pub fn column(
+    world: &mut PhysicsWorld,
+    topple: &mut ToppleRapier,
+    ground: ColliderHandle,
+    material: MaterialId,
+    (half, levels, ratio): (f64, usize, f64),
+) -> (Vec<RigidBodyHandle>, Vec<ColliderHandle>) {
+    let mut bodies = Vec::new();
+    let mut colliders = vec![ground];
+    for k in 0..levels {
+        let density = ratio.powi(k as i32 - 2) / (2.0 * half).powi(2);
+        let x = 0.002 * if k % 2 == 0 { 1.0 } else { -1.0 };
+        let (b, c) = world.insert(
+            RigidBodyBuilder::dynamic().translation(Vector::new(x, half * (2 * k + 1) as f64)),
+            ColliderBuilder::cuboid(half, half).density(density),
+        );
+        topple.manage(&mut world.colliders, c, material);
+        bodies.push(b);
+        colliders.push(c);
+    }
+    (bodies, colliders)
+}
+
+/// The impact events of the last step that moved a body of `stack`.
+pub fn stack_impacts(topple: &ToppleRapier, stack: &[RigidBodyHandle]) -> usize {
+    topple
+        .last_events()
+        .iter()
+        .filter(|e| topple.event_bodies(e).iter().any(|b| stack.contains(b)))
+        .count()
+}
+
+/// The deepest overlap (m) between consecutive colliders of `column` (the
+/// ground first, then each box on the one below), 0 where none overlap.
+pub fn deepest_in_column(set: &ColliderSet, column: &[ColliderHandle]) -> f64 {
+    let mut deepest: f64 = 0.0;
+    for pair in column.windows(2) {
+        let (a, b) = (&set[pair[0]], &set[pair[1]]);
+        let c = query::contact(a.position(), a.shape(), b.position(), b.shape(), 0.0)
+            .expect("boxes and the ground have a contact query");
+        if let Some(c) = c {
+            deepest = deepest.max(-c.dist);
+        }
+    }
+    deepest
+}
