@@ -16,7 +16,9 @@
 //! ```
 //!
 //! Prints per scene and engine the mean and worst frame (whole `update()`)
-//! and how many frames took longer than 1/60 s, topple's share, and what topple did (impacts, fallbacks, steps whose
+//! and how many frames took longer than 1/60 s, topple's share, topple's
+//! Rapier steps per frame (sub-steps and splits; native takes one), and
+//! what topple did (impacts, fallbacks, steps whose
 //! work budget ran out, pairs left to Rapier), and per scene whether any
 //! body's state became NaN and how far the lowest body reached below the
 //! ground's top face. A second table gives the CPU time of the process per
@@ -47,6 +49,9 @@ struct Run {
     /// Frames longer than 1/60 s.
     slow: usize,
     topple_ms: f64,
+    /// Rapier steps per frame (topple's sub-steps and splits; native's
+    /// bevy_rapier step is not counted here: one a frame at `Fixed`).
+    rapier_steps: f64,
     impacts: u64,
     fallbacks: u64,
     budget_spent: u64,
@@ -65,6 +70,7 @@ fn measure(app: &mut App, frames: usize, ground_y: f32) -> Run {
         cpu_worst_ms: 0.0,
         slow: 0,
         topple_ms: 0.0,
+        rapier_steps: 0.0,
         impacts: 0,
         fallbacks: 0,
         budget_spent: 0,
@@ -91,6 +97,7 @@ fn measure(app: &mut App, frames: usize, ground_y: f32) -> Run {
         run.slow += usize::from(ms > 1e3 / 60.0);
         let s = app.world().resource::<ToppleFrameStats>();
         run.topple_ms += 1e3 * s.topple_seconds;
+        run.rapier_steps += s.rapier_steps as f64;
         run.impacts += s.impacts;
         run.fallbacks += s.fallbacks;
         run.budget_spent += s.budget_spent;
@@ -99,6 +106,7 @@ fn measure(app: &mut App, frames: usize, ground_y: f32) -> Run {
     run.mean_ms = 1e3 * start.elapsed().as_secs_f64() / frames as f64;
     run.cpu_mean_ms = (process_cpu_ms() - cpu_start) / frames as f64;
     run.topple_ms /= frames as f64;
+    run.rapier_steps /= frames as f64;
     let world = app.world_mut();
     let mut q = world.query_filtered::<(&Transform, &Velocity, &Collider), With<RigidBody>>();
     for (t, v, c) in q.iter(world) {
@@ -219,7 +227,7 @@ fn print(scene: &str, frames: usize, native: &Run, topple: &Run) {
         }
     };
     println!(
-        "| {scene} | {frames} | {:.3} | {:.2} | {} | {:.3} | {:.2} | {} | {:.3} | {:.2} | {:.2} | {} | {} | {} | {} | {} / {} |",
+        "| {scene} | {frames} | {:.3} | {:.2} | {} | {:.3} | {:.2} | {} | {:.3} | {:.2} | {:.2} | {:.2} | {} | {} | {} | {} | {} / {} |",
         native.mean_ms,
         native.worst_ms,
         native.slow,
@@ -227,6 +235,7 @@ fn print(scene: &str, frames: usize, native: &Run, topple: &Run) {
         topple.worst_ms,
         topple.slow,
         topple.topple_ms,
+        topple.rapier_steps,
         topple.mean_ms / native.mean_ms,
         topple.worst_ms / native.worst_ms,
         topple.impacts,
@@ -244,9 +253,9 @@ fn main() {
         .filter(|a| !a.starts_with('-'))
         .collect();
     let want = |name: &str| wanted.is_empty() || wanted.iter().any(|w| name.contains(w.as_str()));
-    println!("| scene | frames | native mean (ms) | native worst (ms) | native frames > 1/60 s | topple mean (ms) | topple worst (ms) | topple frames > 1/60 s | topple's own (ms/frame) | mean ratio | worst ratio | impacts | fallbacks | budget ran out | left to Rapier | below ground (native / topple) |");
+    println!("| scene | frames | native mean (ms) | native worst (ms) | native frames > 1/60 s | topple mean (ms) | topple worst (ms) | topple frames > 1/60 s | topple's own (ms/frame) | topple's Rapier steps per frame | mean ratio | worst ratio | impacts | fallbacks | budget ran out | left to Rapier | below ground (native / topple) |");
     println!(
-        "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |"
+        "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |"
     );
     if want("pyramid") {
         let (f, ground) = (180, 0.0);
