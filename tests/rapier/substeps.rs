@@ -98,3 +98,39 @@ fn a_frame_is_four_rapier_steps_at_the_frames_rapier_substep() {
         "{one:?} against {four:?}"
     );
 }
+
+/// The f32 build (bevy_rapier's) cuts a 1/60 s frame into the same four
+/// pieces of 1/240 s as the f64 build: 1/60 s as f32 over 1/240 s is
+/// 4.0000002, and the count of pieces must not depend on that rounding (it
+/// was 5 in the f32 build). The same sliding box as above, in f32.
+#[test]
+fn the_f32_build_cuts_a_sixtieth_of_a_second_into_four_pieces_too() {
+    use topple::rapier::f32::ToppleRapier as ToppleRapier32;
+    use topple::rapier2d::prelude as r32;
+    let frames = 6;
+    let mut topple = ToppleRapier32::new(ToppleSettings::default());
+    let mut world = r32::PhysicsWorld::default();
+    world.integration_parameters.dt = 1.0 / 60.0;
+    let material = topple.add_material(PairMaterial {
+        impact: ContactMaterial::hertz(1e9).with_restitution(0.0),
+        smooth_friction: 0.3,
+    });
+    let ground = world.insert_collider(
+        r32::ColliderBuilder::cuboid(5.0, 0.1).translation(r32::Vector::new(0.0, -0.1)),
+        None,
+    );
+    topple.manage(&mut world.colliders, ground, material);
+    let (_, collider) = world.insert(
+        r32::RigidBodyBuilder::dynamic()
+            .translation(r32::Vector::new(0.0, 0.05))
+            .linvel(r32::Vector::new(4.0, 0.0)),
+        r32::ColliderBuilder::cuboid(0.05, 0.05),
+    );
+    topple.manage(&mut world.colliders, collider, material);
+    for _ in 0..frames {
+        topple.step(&mut world);
+    }
+    let stats = topple.stats();
+    assert_eq!(stats.rapier_steps, 4 * frames as u64, "{stats:?}");
+    assert_eq!(stats.impacts, 0, "{stats:?}");
+}
