@@ -8,42 +8,48 @@ use topple::stress::{draw, run_combo, violations, Kind, Observation, StressEngin
 /// Combination 896 of the full sweep, seed 1 (Domino X, s/h 0.102, 13
 /// blocks, e1 0.6, e2 0.5, Rapier f64 at Δt = 1/120 s): after the last
 /// block slides out ahead of the row and falls flat, the train behind it
-/// settles back and block 11 comes back below π/4 (docs/stress.md, "A
-/// fallen count native Rapier drops as well"). Native Rapier on the same
-/// row, perturbation and step does it too, by more; topple's run at half
-/// the step, closer to the continuous motion, does not: a step-length
-/// artefact of Rapier's contacts that topple does not add to, so not
-/// topple's violation.
+/// settles back, and native Rapier stands fallen blocks back up past π/4
+/// (docs/stress.md, "A fallen count native Rapier drops as well"; on the
+/// step loop before Rapier's substep was kept native inside the pieces,
+/// topple stood block 11 up by 8.1°, native blocks 11 and 12 by 12.8°).
+/// Native Rapier, stepped alone, must show that drop (it is what the rule
+/// holds topple's runs against); topple's run, at the drawn step and at
+/// half of it, must have no violation; and where topple's run drops a
+/// block, native must have been run beside it, as the rule asks.
 #[test]
-fn a_drop_native_rapier_makes_as_well_at_the_same_step_is_the_baseline() {
+fn combo_896_native_rapier_stands_blocks_up_topple_does_not() {
     let spec = SweepSpec::full(1);
     let c = draw(1, 896, spec.n_lo, spec.n_hi);
     assert_eq!(c.engine, StressEngine::RapierF64);
-    let o = run_combo(&c, 120.0);
+    let mut native = c.clone();
+    native.engine = StressEngine::Native;
+    let n = run_combo(&native, 120.0);
     println!(
-        "topple: drop {} (blocks {:?}, {:.2}°), reference {:?}, native {:?}",
-        o.fallen_drop,
-        o.stood_up,
-        o.stood_up_rock_back.to_degrees(),
-        o.reference_rock_back.map(f64::to_degrees),
-        o.native_drop.map(|(d, r)| (d, r.to_degrees()))
+        "native: drop {} (blocks {:?}, {:.2}°)",
+        n.fallen_drop,
+        n.stood_up,
+        n.stood_up_rock_back.to_degrees()
     );
-    assert!(
-        o.fallen_drop > 0,
-        "the drop this test is about did not occur"
-    );
-    let (native_drop, native_rock) = o.native_drop.expect("native Rapier was run");
-    assert!(native_drop >= o.fallen_drop && native_rock >= o.stood_up_rock_back);
-    assert!(violations(&c, &o).is_empty());
-
-    let mut finer = c.clone();
-    finer.dt = c.dt / 2.0;
-    let f = run_combo(&finer, 120.0);
-    println!(
-        "topple at Δt/2: drop {} (blocks {:?})",
-        f.fallen_drop, f.stood_up
-    );
-    assert_eq!(f.fallen_drop, 0);
+    assert!(n.fallen_drop > 0, "native Rapier kept its blocks down");
+    for div in [1.0, 2.0] {
+        let mut t = c.clone();
+        t.dt = c.dt / div;
+        let o = run_combo(&t, 120.0);
+        println!(
+            "topple at Δt/{div}: drop {} (blocks {:?}, {:.2}°), native beside it {:?}",
+            o.fallen_drop,
+            o.stood_up,
+            o.stood_up_rock_back.to_degrees(),
+            o.native_drop.map(|(d, r)| (d, r.to_degrees()))
+        );
+        assert!(violations(&t, &o).is_empty(), "Δt/{div}");
+        if o.fallen_drop > 0
+            && o.reference_rock_back
+                .is_some_and(|r| r < o.stood_up_rock_back)
+        {
+            assert!(o.native_drop.is_some(), "native not run beside the drop");
+        }
+    }
 }
 
 /// The rule on hand-made observations of a dissipative row (e1 0.6, e2
