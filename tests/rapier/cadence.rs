@@ -24,19 +24,10 @@ use topple::impact::ContactMaterial;
 use topple::rapier::f64::ToppleRapier;
 use topple::rapier2d_f64::prelude::*;
 
-const HALF: f64 = 0.05; // m, half side of a box
-const LEVELS: usize = 4;
+use super::stack::{Run, HALF, LEVELS};
+
 const FRAME: f64 = 1.0 / 60.0; // s
 const FRAMES: usize = 120; // 2 s
-
-struct Run {
-    /// Deepest overlap (m) of two neighbours in the stack or of the bottom
-    /// box and the ground, over the run.
-    deepest: f64,
-    /// Impact groups with a stack body in them.
-    stack_impacts: usize,
-    rapier_steps: u64,
-}
 
 /// The stack and the slider stepped `FRAMES` frames, each as `per_frame`
 /// calls of `topple.step` of FRAME / `per_frame` with `iterations` solver
@@ -81,11 +72,7 @@ fn run(mut topple: ToppleRapier, per_frame: usize, iterations: usize) -> Run {
         ColliderBuilder::cuboid(HALF, HALF).density(100.0),
     );
     topple.manage(&mut world.colliders, slider, ice);
-    let mut out = Run {
-        deepest: 0.0,
-        stack_impacts: 0,
-        rapier_steps: 0,
-    };
+    let mut out = Run::default();
     for _ in 0..FRAMES * per_frame {
         topple.step(&mut world);
         out.stack_impacts += super::stack::stack_impacts(&topple, &stack);

@@ -8,6 +8,25 @@ use topple::rapier::f64::ToppleRapier;
 use topple::rapier2d_f64::parry::query;
 use topple::rapier2d_f64::prelude::*;
 
+/// Half side of a box of the column (m).
+pub const HALF: f64 = 0.05;
+/// Boxes in the column.
+pub const LEVELS: usize = 4;
+
+/// What a run of a column shows.
+#[derive(Debug, Default)]
+pub struct Run {
+    /// Deepest overlap (m) of two neighbours in the column or of the
+    /// bottom box and the ground, over the run.
+    pub deepest: f64,
+    /// Impact groups with a column body in them.
+    pub stack_impacts: usize,
+    /// Impacts topple resolved anywhere.
+    pub impacts: usize,
+    /// Rapier steps taken (topple's sub-steps and splits included).
+    pub rapier_steps: u64,
+}
+
 /// A column of `levels` square boxes of half side `half` (m) on the ground
 /// collider `ground`, of masses ratio^(k−2) kg from the bottom (k = 0) up,
 /// each resting on the one below, off centre by 2 % of its side either

@@ -24,20 +24,10 @@ use topple::impact::ContactMaterial;
 use topple::rapier::f64::ToppleRapier;
 use topple::rapier2d_f64::prelude::*;
 
-const HALF: f64 = 0.05; // m, half side of a box
-const LEVELS: usize = 4;
+use super::stack::{Run, HALF, LEVELS};
+
 const DT: f64 = 1.0 / 60.0; // s
 const FRAMES: usize = 180; // 3 s
-
-/// The deepest overlap (m) of two neighbours in the stack, or of the bottom
-/// box and the ground, over the run; and the impacts topple resolved in
-/// the stack (none expected) and elsewhere.
-struct Run {
-    deepest: f64,
-    stack_impacts: usize,
-    impacts: usize,
-    rapier_steps: u64,
-}
 
 fn run(topple_mode: bool) -> Run {
     run_with(topple_mode, 2.0, LEVELS, 1.0)
@@ -79,12 +69,7 @@ fn run_with(topple_mode: bool, ratio: f64, levels: usize, ball_e: f64) -> Run {
         ColliderBuilder::ball(0.05).density(1000.0),
     );
     topple.manage(&mut world.colliders, ball, rubber);
-    let mut out = Run {
-        deepest: 0.0,
-        stack_impacts: 0,
-        impacts: 0,
-        rapier_steps: 0,
-    };
+    let mut out = Run::default();
     for _ in 0..FRAMES {
         topple.step(&mut world);
         out.impacts += topple.last_impacts().len();
