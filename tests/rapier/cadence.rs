@@ -75,11 +75,8 @@ fn run(mut topple: ToppleRapier, per_frame: usize, iterations: usize) -> Run {
     let mut out = Run::default();
     for _ in 0..FRAMES * per_frame {
         topple.step(&mut world);
-        out.stack_impacts += super::stack::stack_impacts(&topple, &stack);
-        let deepest = super::stack::deepest_in_column(&world.colliders, &colliders);
-        out.deepest = out.deepest.max(deepest);
+        out.watch(&topple, &world, &stack, &colliders);
     }
-    out.rapier_steps = topple.stats().rapier_steps;
     out
 }
 

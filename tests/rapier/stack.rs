@@ -27,6 +27,25 @@ pub struct Run {
     pub rapier_steps: u64,
 }
 
+impl Run {
+    /// Records one step of `topple` on `world`: its impacts, those in
+    /// `stack`, and the deepest overlap of `column`.
+    pub fn watch(
+        &mut self,
+        topple: &ToppleRapier,
+        world: &PhysicsWorld,
+        stack: &[RigidBodyHandle],
+        column: &[ColliderHandle],
+    ) {
+        self.impacts += topple.last_impacts().len();
+        self.stack_impacts += stack_impacts(topple, stack);
+        self.deepest = self
+            .deepest
+            .max(deepest_in_column(&world.colliders, column));
+        self.rapier_steps = topple.stats().rapier_steps;
+    }
+}
+
 /// A column of `levels` square boxes of half side `half` (m) on the ground
 /// collider `ground`, of masses ratio^(k−2) kg from the bottom (k = 0) up,
 /// each resting on the one below, off centre by 2 % of its side either

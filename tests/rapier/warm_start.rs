@@ -72,12 +72,8 @@ fn run_with(topple_mode: bool, ratio: f64, levels: usize, ball_e: f64) -> Run {
     let mut out = Run::default();
     for _ in 0..FRAMES {
         topple.step(&mut world);
-        out.impacts += topple.last_impacts().len();
-        out.stack_impacts += super::stack::stack_impacts(&topple, &stack);
-        let deepest = super::stack::deepest_in_column(&world.colliders, &colliders);
-        out.deepest = out.deepest.max(deepest);
+        out.watch(&topple, &world, &stack, &colliders);
     }
-    out.rapier_steps = topple.stats().rapier_steps;
     out
 }
 
