@@ -10,6 +10,8 @@
 
 use ::rapier2d as backend;
 
+#[path = "adapter/cadence.rs"]
+mod cadence;
 #[path = "adapter/chain.rs"]
 pub mod chain;
 #[path = "adapter/hooks.rs"]

@@ -12,8 +12,8 @@ use super::backend::prelude::{
     PhysicsHooks, PhysicsPipeline, PhysicsWorld, RigidBodyHandle, RigidBodySet, Vector,
 };
 
+use super::cadence::Cadence;
 use super::hooks::{ChainedHooks, ToppleHooks};
-use super::motion::Cadence;
 use super::pass::{ImpactContact, ImpactEvent, ImpactPass, Prediction, World};
 use super::scale;
 use super::support::{self, Notice};
