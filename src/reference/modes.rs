@@ -171,9 +171,11 @@ fn options(rc: &RowConst, c: &Candidate, tol: &ModeTol) -> ([Option<Mode>; 4], u
 
 /// Finds the mode; `out` receives the pressing contacts, in candidate order
 /// (which must be sorted by block). Returns false if no consistent mode was
-/// found: the last one tried is kept, less the contacts whose normal force
-/// pulls (they lift off) and with the contacts that stick beyond their cone
-/// sliding.
+/// found: the last one tried is kept with every contact whose normal force
+/// pulls relaxed one step at a time (a stuck one slides, a sliding one
+/// presses without friction, a frictionless one lifts off) and the contacts
+/// that stick beyond their cone sliding; the engine then searches again
+/// after its next step.
 ///
 /// The search changes the worst violation's contact one at a time (all of
 /// them in the first six rounds). It is deterministic, so a state it has
@@ -307,21 +309,37 @@ pub(crate) fn select(
     // can). Never keep a contact that pulls, nor one that sticks beyond its
     // cone: either would call for an event at every step and stall the run
     // (a lift-off or stick → slip event fires as soon as the violation
-    // grows). Let the worst pulling contact lift off, else let the worst
-    // overloaded sticking contact slide, and repeat; if a contact that
-    // lifted off then closes again, that is an event of its own.
-    for _ in 0..2 * out.len() {
+    // grows). Relax the worst pulling contact by one step, else let the
+    // worst overloaded sticking contact slide, and repeat; if a contact
+    // that lifted off then closes again, that is an event of its own.
+    //
+    // A sliding contact that pulls is Painlevé's case (docs/stress.md, "A
+    // sliding contact its friction pulls"): with the friction of sliding
+    // its row of the contact problem has no solution with F_n ≥ 0. Lifting
+    // it off (as before) lets it approach again at once, and an e = 0 train
+    // then repeats that impact at one instant without end; pressing without
+    // friction keeps it closed, and the search runs again after the step.
+    for _ in 0..3 * out.len() + 1 {
         let pulling = (0..out.len())
             .filter(|&k| dyn_.fn_[k] < -tol.force)
             .min_by(|&a, &b| dyn_.fn_[a].total_cmp(&dyn_.fn_[b]));
-        if let Some(k) = pulling.filter(|&k| !can_slide(rc, &out[k])) {
-            out.remove(k);
-        } else if let Some(k) = pulling {
-            // a stuck contact that pulls slides first: its stick row may be
-            // what pulls it (a stuck set can be nearly singular, its
-            // forces far beyond the weights), and a stuck contact's
-            // friction needs a normal force to bound it
-            out[k].mode = slide_against(rc, out[k].slot, dyn_.ft[k]);
+        if let Some(k) = pulling {
+            match out[k].mode {
+                // a stuck contact that pulls slides first: its stick row may
+                // be what pulls it (a stuck set can be nearly singular, its
+                // forces far beyond the weights), and a stuck contact's
+                // friction needs a normal force to bound it
+                Mode::Stick if can_slide(rc, &out[k]) => {
+                    out[k].mode = slide_against(rc, out[k].slot, dyn_.ft[k]);
+                }
+                // a sliding contact that pulls (Painlevé's case: the
+                // friction of sliding drives the contact into tension)
+                // presses without friction until the next search
+                Mode::Slide(_) => out[k].mode = Mode::Frictionless,
+                _ => {
+                    out.remove(k);
+                }
+            }
         } else {
             let excess = |k: usize| rc.stick_excess(out[k].slot, dyn_.ft[k], dyn_.fn_[k]);
             let Some(k) = (0..out.len())

@@ -262,6 +262,37 @@ fn combos_1700_and_2220_of_the_full_sweeps_hold_their_resting_contacts() {
     }
 }
 
+/// Combo 140 of the full sweep's seed 2 (Domino X, s/h 0.136, 18 blocks,
+/// e1 = e2 = 0, μ1 0.54, μ2 0.95, Δt 0.1 ms): behind the wave a leaning
+/// e = 0 train, where block 2's heel slides up block 1's front face. With
+/// the friction of sliding that contact's row has no solution with
+/// F_n ≥ 0 (Painlevé's case: the mode search's best mode pulls it with
+/// −1.2·10³ N on 1 kg blocks). Lifting it off let it approach again at
+/// once, and the engine repeated that impact at one instant without end:
+/// 10⁵ impacts by 17 of 18 hits at the sweep's budget of 120 s. The
+/// search's fallback now lets a sliding contact that pulls press without
+/// friction, and searches again after the next step.
+///
+/// The run must pass every check of the sweep (energy of every impact,
+/// overlap watch from the poses alone) with the wave through every block.
+#[test]
+fn combo_140_of_the_second_full_sweep_runs_through_its_leaning_train() {
+    let (seed, index) = (2, 140);
+    let spec = SweepSpec::full(seed);
+    let c = draw(seed, index, spec.n_lo, spec.n_hi);
+    assert_eq!(c.engine, StressEngine::Reference);
+    assert_eq!((c.row.n, c.row.params.e1, c.row.params.e2), (18, 0.0, 0.0));
+    let o = run_combo(&c, 120.0);
+    let v = violations(&c, &o);
+    println!(
+        "seed {seed} combo {index}: {} hits of {}, {} impacts, overlap {:.3e} h, {:.1} s of CPU",
+        o.hits, c.row.n, o.audit.impacts, o.penetration, o.cpu
+    );
+    assert!(v.is_empty(), "{v:?}");
+    assert!(!o.over_budget);
+    assert_eq!(o.hits, c.row.n, "the wave reaches the last block");
+}
+
 /// `Settings::max_steps` stops a run after that many accepted steps and
 /// says so, whatever the machine's load.
 #[test]

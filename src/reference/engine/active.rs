@@ -153,10 +153,10 @@ impl Engine {
                 y: &self.y,
                 pos: &self.pos,
             };
-            // a search that does not converge keeps its last mode minus any
-            // pulling contact (see `select`); the events of the next step
-            // correct it
-            let _ = select(
+            // a search that does not converge keeps its last mode without
+            // any pulling contact (see `select`), and runs again after the
+            // next step
+            self.mode_unsettled = !select(
                 &mut self.dynamics,
                 &self.rc,
                 &view,

@@ -350,7 +350,7 @@ impl Engine {
         self.energy.friction += self.y[last];
         self.y[last] = 0.0;
         self.h_adapt = h_next;
-        if event {
+        if event || self.mode_unsettled {
             self.handle_events()?;
         } else {
             self.project();

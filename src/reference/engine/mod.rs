@@ -230,6 +230,9 @@ struct Engine {
     /// row have found an impact at that same instant.
     last_impact_time: f64,
     impacts_at_this_instant: usize,
+    /// The last mode search found no consistent mode (`modes::select`): the
+    /// search runs again after every step until it does.
+    mode_unsettled: bool,
     probe: EventProbe,
     /// Bounds on the gaps of the window's candidate slots (`scan.rs`).
     gap_bounds: scan::GapBounds,
@@ -312,6 +315,7 @@ impl Engine {
             reversed: vec![false; n],
             last_impact_time: f64::NEG_INFINITY,
             impacts_at_this_instant: 0,
+            mode_unsettled: false,
             probe: EventProbe::default(),
             gap_bounds: scan::GapBounds::new(k_slots, p.block.height, p.block.thickness),
             start_forces: Vec::new(),
