@@ -32,7 +32,9 @@ mod sweep;
 
 pub use combo::{draw, reproduce, Combo, SplitMix64, StressEngine};
 pub use engines::run_combo;
-pub use observe::{Observation, RowWatch, FALLEN_TILT, LYING_GAP, LYING_TIME};
+pub use observe::{
+    NativeRockBack, Observation, RowWatch, FALLEN_TILT, LYING_GAP, LYING_TIME, ROW_NEARBY_PUSH,
+};
 pub use sweep::{
     combos_of, sweep, table, tolerance, violations, Kind, SweepResult, SweepSpec, Violation,
 };

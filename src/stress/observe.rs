@@ -31,6 +31,27 @@ pub const LYING_GAP: f64 = 1e-3;
 /// once, one that lies on it stays.
 pub const LYING_TIME: f64 = 0.01;
 
+/// A topple Rapier run's drop of the fallen count held against native
+/// Rapier: the run and [`crate::stress::scene::NEARBY_RUNS`] nearby starts
+/// (block 1's push changed by k · [`ROW_NEARBY_PUSH`]), each in topple's
+/// engine and in native Rapier of the same build at the same step.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct NativeRockBack {
+    /// topple's least [`Observation::stood_up_rock_back`] over its starts
+    /// (rad; 0 where a start stands no block up).
+    pub topple_least: f64,
+    /// native's largest [`Observation::fallen_rock_back`] over its starts
+    /// (rad): how far it rocks a fallen block back, across π/4 or not.
+    pub native_most: f64,
+    /// native's largest [`Observation::fallen_drop`] over its starts.
+    pub native_drop: usize,
+}
+
+/// Change of block 1's dimensionless push θ̇₁ √(h/g) between nearby starts
+/// of a row (about 10⁻⁶ √(gh) m/s at its top: far below any speed a step
+/// resolves, far above the round-off of f64 speeds).
+pub const ROW_NEARBY_PUSH: f64 = 1e-6;
+
 /// The observations of one run.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct Observation {
@@ -75,10 +96,10 @@ pub struct Observation {
     /// not be run).
     pub reference_rock_back: Option<f64>,
     /// For a topple Rapier run whose fallen count dropped where the
-    /// reference does not explain it: native Rapier of the same build on the
-    /// same row, perturbation and step, as (its [`Observation::fallen_drop`],
-    /// its [`Observation::stood_up_rock_back`] in rad); `None` if not run.
-    pub native_drop: Option<(usize, f64)>,
+    /// reference does not explain it: the same row, perturbation and step
+    /// from nearby starts, in topple's engine and in native Rapier of the
+    /// same build ([`NativeRockBack`]); `None` if not run.
+    pub native_rock_back: Option<NativeRockBack>,
     /// Fallen blocks (1-based) that came back below [`FALLEN_TILT`], in the
     /// order they first did.
     pub stood_up: Vec<usize>,

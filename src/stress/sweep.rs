@@ -196,9 +196,9 @@ pub fn violations(c: &Combo, o: &Observation) -> Vec<Violation> {
     };
     // a drop the reference shows on the same row too is physics, and so is
     // a block rocking back across π/4 by no more than a fallen block rocks
-    // back in the reference on the same row; one native Rapier shows at
-    // least as large on the same row and step is the baseline's (see
-    // `run_combo`)
+    // back in the reference on the same row; a rock-back native Rapier
+    // makes at least as large on the same row and step, from nearby starts,
+    // is the baseline's (see `run_combo`)
     let explained = explained_by_reference(o) || explained_by_native(o);
     let fallen_drop = if dissipative && !explained {
         o.fallen_drop as f64
@@ -260,10 +260,13 @@ fn describe(c: &Combo, o: &Observation) -> String {
                 o.reference_rock_back
                     .map(|r| format!(", reference's {:.2}°", r.to_degrees()))
                     .unwrap_or_default(),
-                o.native_drop
-                    .map(|(d, r)| format!(
-                        "; native Rapier at the same step: dropped by {d}, {:.2}°",
-                        r.to_degrees()
+                o.native_rock_back
+                    .map(|r| format!(
+                        "; from its start and {} nearby at the same step: topple stands one up by at least {:.2}°, native Rapier rocks one back by at most {:.2}° and drops up to {}",
+                        super::scene::NEARBY_RUNS,
+                        r.topple_least.to_degrees(),
+                        r.native_most.to_degrees(),
+                        r.native_drop
                     ))
                     .unwrap_or_default(),
             )
@@ -289,6 +292,8 @@ pub struct SweepResult {
     pub violations: Vec<Violation>,
     /// CPU time of the longest run (s).
     pub longest_run: f64,
+    /// The combination of the longest run.
+    pub longest_combo: usize,
     /// Worst penetration (over h) per engine and time step (µs).
     pub penetration: BTreeMap<(StressEngine, u64), f64>,
     /// The combination and what it showed, when one alone was run.
@@ -341,7 +346,10 @@ pub fn sweep(
         *r.runs.entry(c.engine).or_default() += 1;
         r.impacts += o.audit.impacts;
         r.elastic_impacts += o.audit.elastic_impacts;
-        r.longest_run = r.longest_run.max(o.cpu);
+        if o.cpu > r.longest_run {
+            r.longest_run = o.cpu;
+            r.longest_combo = c.index;
+        }
         if c.engine != StressEngine::Impact {
             let w = r
                 .penetration
@@ -394,8 +402,8 @@ pub fn table(spec: &SweepSpec, r: &SweepResult) -> String {
     );
     let _ = writeln!(
         s,
-        "longest run {:.1} s of CPU (budget {} s of CPU per run)",
-        r.longest_run, spec.budget
+        "longest run {:.1} s of CPU, combination {} (budget {} s of CPU per run)",
+        r.longest_run, r.longest_combo, spec.budget
     );
     let _ = writeln!(
         s,
