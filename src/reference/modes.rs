@@ -169,13 +169,29 @@ fn options(rc: &RowConst, c: &Candidate, tol: &ModeTol) -> ([Option<Mode>; 4], u
     (o, n)
 }
 
+/// How [`select`] ended.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) enum Search {
+    /// A consistent mode (Eqs. 18–20 hold within the tolerances).
+    Consistent,
+    /// The contact system was singular; `out` holds the last mode tried.
+    Singular,
+    /// No consistent mode: the last one tried, its pulling contacts lifted
+    /// off or sliding, its overloaded stuck contacts sliding. The events of
+    /// the next steps correct it.
+    Relaxed,
+    /// As [`Search::Relaxed`], and a sliding contact that pulled presses
+    /// without friction (Painlevé's case): a stop-gap no event ends, so the
+    /// engine searches again after the next step.
+    Frictionless,
+}
+
 /// Finds the mode; `out` receives the pressing contacts, in candidate order
-/// (which must be sorted by block). Returns false if no consistent mode was
-/// found: the last one tried is kept with every contact whose normal force
-/// pulls relaxed one step at a time (a stuck one slides, a sliding one
-/// presses without friction, a frictionless one lifts off) and the contacts
-/// that stick beyond their cone sliding; the engine then searches again
-/// after its next step.
+/// (which must be sorted by block). If no consistent mode is found, the
+/// last one tried is kept with every contact whose normal force pulls
+/// relaxed one step at a time (a stuck one slides, a sliding one presses
+/// without friction, a frictionless one lifts off) and the contacts that
+/// stick beyond their cone sliding ([`Search`]).
 ///
 /// The search changes the worst violation's contact one at a time (all of
 /// them in the first six rounds). It is deterministic, so a state it has
@@ -191,7 +207,7 @@ pub(crate) fn select(
     state: &mut Vec<Option<Mode>>,
     out: &mut Vec<Active>,
     tol: &ModeTol,
-) -> bool {
+) -> Search {
     state.clear();
     state.extend(
         candidates
@@ -211,10 +227,10 @@ pub(crate) fn select(
         }
         tried[iter] = key;
         let Some(a) = assess(dyn_, rc, view, candidates, state, out, tol) else {
-            return false;
+            return Search::Singular;
         };
         let Some((_, ci, next)) = a.worst else {
-            return true;
+            return Search::Consistent;
         };
         let mut note = |ci: usize| {
             if n_changed < changed.len() {
@@ -261,8 +277,8 @@ pub(crate) fn select(
                     code /= n;
                 }
                 match assess(dyn_, rc, view, candidates, state, out, tol) {
-                    None => return false,
-                    Some(a) if a.worst.is_none() => return true,
+                    None => return Search::Singular,
+                    Some(a) if a.worst.is_none() => return Search::Consistent,
                     Some(_) => {}
                 }
             }
@@ -301,8 +317,8 @@ pub(crate) fn select(
     }
     dyn_.keep_relax_forces(forces);
     match assess(dyn_, rc, view, candidates, state, out, tol) {
-        None => return false,
-        Some(a) if a.worst.is_none() => return true,
+        None => return Search::Singular,
+        Some(a) if a.worst.is_none() => return Search::Consistent,
         Some(_) => {}
     }
     // No consistent mode (the search cycles, as frictional contact problems
@@ -354,7 +370,15 @@ pub(crate) fn select(
             break;
         }
     }
-    false
+    // a contact with friction left pressing without it
+    if out
+        .iter()
+        .any(|a| a.mode == Mode::Frictionless && rc.mu(a.slot).0 > 0.0)
+    {
+        Search::Frictionless
+    } else {
+        Search::Relaxed
+    }
 }
 
 /// Whether a pressing contact in [`Mode::Stick`] may slide instead (μ_s

@@ -4,7 +4,7 @@
 
 use super::super::dynamics::{Active, RowConst, View};
 use super::super::geometry::{Geom, Kin};
-use super::super::modes::{initial_mode, select, Candidate};
+use super::super::modes::{initial_mode, select, Candidate, Search};
 use super::Engine;
 
 /// Slot `slot` of block `i` if it is a closed contact (gap ≤ `eps`, m)
@@ -154,9 +154,9 @@ impl Engine {
                 pos: &self.pos,
             };
             // a search that does not converge keeps its last mode without
-            // any pulling contact (see `select`), and runs again after the
-            // next step
-            self.mode_unsettled = !select(
+            // any pulling contact (see `select`); one that let a sliding
+            // contact press without friction runs again after the next step
+            let search = select(
                 &mut self.dynamics,
                 &self.rc,
                 &view,
@@ -165,6 +165,7 @@ impl Engine {
                 &mut self.new_active,
                 &self.tol,
             );
+            self.mode_unsettled = search == Search::Frictionless;
         }
         self.candidates = cands;
         self.set_active();

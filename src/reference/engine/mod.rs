@@ -230,8 +230,9 @@ struct Engine {
     /// row have found an impact at that same instant.
     last_impact_time: f64,
     impacts_at_this_instant: usize,
-    /// The last mode search found no consistent mode (`modes::select`): the
-    /// search runs again after every step until it does.
+    /// The last mode search let a sliding contact press without friction
+    /// (`modes::Search::Frictionless`): the search runs again after every
+    /// step until it ends otherwise.
     mode_unsettled: bool,
     probe: EventProbe,
     /// Bounds on the gaps of the window's candidate slots (`scan.rs`).
