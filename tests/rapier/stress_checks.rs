@@ -470,14 +470,16 @@ fn a_body_native_rapier_also_puts_below_the_ground_is_the_baseline() {
         .any(|v| v.kind == Kind::ThroughGround));
 }
 
-/// Scene 31 of `topple stress --family scenes --quick --seed 21`, whose
-/// impacts decide where its bodies land. The drawn run is 1.53 of the least
-/// width deep against native Rapier's 1.30; from nearby starts (every x
+/// Scene 3 of `topple stress --family scenes --quick --seed 4`, whose
+/// impacts decide where its bodies land. The drawn run is 0.765 of the least
+/// width deep against native Rapier's 0.744; from nearby starts (every x
 /// velocity changed by steps of 10⁻⁶ m/s) topple's depth lies on both sides
-/// of native's deepest (measured 1.22–1.53): a chaotic scene, where one run
-/// of each compares two draws. (Seed 4's scene 3 was such a scene until the
-/// resolver's friction-onset fix changed its impacts; among seeds 1–30 this
-/// one has the widest spread on the present code.) The check reads
+/// of native's deepest (measured 0.660–0.903): a chaotic scene, where one run
+/// of each compares two draws. (Seed 21's scene 31 was such a scene until
+/// the resolver stopped landing on a closing twice, docs/impact.md "Steps
+/// per impact, this round": its drawn run is now 1.06 deep against native's
+/// 1.30, not rerun; seed 4's scene 3 has the widest spread of the chaotic
+/// scenes of seeds 1–10 on the present code.) The check reads
 /// topple's shallowest run against native's deepest, so it is not counted.
 /// Scene 30 of seed 1 (an f64 stack whose excess comes with the adapter's
 /// sub-steps, docs/stress.md) is deeper than native from every start (0.670
@@ -495,7 +497,7 @@ fn a_chaotic_scene_is_judged_from_nearby_starts_a_systematic_excess_still_counts
             .any(|v| v.kind == Kind::Penetration)
     };
 
-    let c = SceneSpec::quick(21).draw(31);
+    let c = SceneSpec::quick(4).draw(3);
     let o = run_scene_combo(&c, 60.0);
     let (native, _) = o.native.expect("native ran on the same scene");
     let near = o.nearby.as_ref().expect("deeper than native: run again");

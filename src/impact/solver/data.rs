@@ -264,6 +264,10 @@ pub(super) struct PointState {
     /// at that same instant (a switch within 10⁻⁹ of a step is rounding),
     /// and is not closed again at it unless it approaches.
     pub(super) switched_at: f64,
+    /// Time (s) at which the point's gap last closed (a `Switch::Closes`
+    /// landed on): a step that starts there finds it a rounding into
+    /// contact, already loading, and does not close it again.
+    pub(super) closed_at: f64,
 
     /// Probe generation in which the point was last noted.
     pub(super) seen: u32,

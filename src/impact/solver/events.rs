@@ -249,7 +249,10 @@ impl Integrator {
             }
             // the segment restarts at the onset (see `Variable::Root`); a
             // patch without slip sticks from here (modes.rs)
-            Switch::Closes(i) => self.closes_after_cycle(i),
+            Switch::Closes(i) => {
+                self.points[i].closed_at = now;
+                self.closes_after_cycle(i);
+            }
             Switch::HoldSpent(i) => {
                 // on from rest, touching, under the law (no stored energy)
                 let point = &mut self.points[i];

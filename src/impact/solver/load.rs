@@ -109,6 +109,7 @@ impl Integrator {
             n,
             PointState {
                 switched_at: f64::NAN,
+                closed_at: f64::NAN,
                 hold_limit: f64::INFINITY,
                 ..PointState::default()
             },

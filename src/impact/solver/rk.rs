@@ -41,11 +41,12 @@ impl Integrator {
         rk.dense_ready = false;
         let x0 = self.clock.x;
         let lay = self.layout;
+        let now = rk.y0[lay.time()];
         for i in 0..self.points.len() {
             let q0 = rk.y0[lay.q(i)];
             let q_zero = self.rows[i].q_zero;
             let open = self.points[i].mode == PointMode::Compress
-                && (q0 < 0.0 || (q0 <= q_zero && !self.loads_from_rest(i, &rk.y0)));
+                && (q0 < 0.0 || (q0 <= q_zero && self.onset_due(i, &rk.y0, now)));
             self.points[i].open = open;
             self.points[i].close_at = if q0 > 0.0 { q_zero } else { 0.0 };
         }
