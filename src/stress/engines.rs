@@ -3,8 +3,7 @@
 use std::time::Instant;
 
 use super::combo::{Combo, SplitMix64, StressEngine};
-use super::observe::{NativeRockBack, Observation, RowWatch, ROW_NEARBY_PUSH};
-use super::scene::NEARBY_RUNS;
+use super::observe::{NativeRockBack, Observation, RowWatch, NEARBY_RUNS, ROW_NEARBY_PUSH};
 use crate::clock::CpuWatch;
 use crate::coupling::{FallbackPolicy, GroupSolver};
 use crate::impact::{audit, Body, Contact, ContactMaterial, ImpactOutcome, ImpactSettings};

@@ -32,7 +32,7 @@ pub const LYING_GAP: f64 = 1e-3;
 pub const LYING_TIME: f64 = 0.01;
 
 /// A topple Rapier run's drop of the fallen count held against native
-/// Rapier: the run and [`crate::stress::scene::NEARBY_RUNS`] nearby starts
+/// Rapier: the run and [`NEARBY_RUNS`] nearby starts
 /// (block 1's push changed by k · [`ROW_NEARBY_PUSH`]), each in topple's
 /// engine and in native Rapier of the same build at the same step.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -51,6 +51,11 @@ pub struct NativeRockBack {
 /// of a row (about 10⁻⁶ √(gh) m/s at its top: far below any speed a step
 /// resolves, far above the round-off of f64 speeds).
 pub const ROW_NEARBY_PUSH: f64 = 1e-6;
+
+/// How many nearby starts a run the check cannot judge from one start is
+/// run from, besides its own: a row whose fallen count dropped (above), a
+/// scene deeper than native Rapier (`scene::run`).
+pub const NEARBY_RUNS: usize = 6;
 
 /// The observations of one run.
 #[derive(Clone, Debug, Default, PartialEq)]

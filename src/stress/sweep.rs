@@ -263,7 +263,7 @@ fn describe(c: &Combo, o: &Observation) -> String {
                 o.native_rock_back
                     .map(|r| format!(
                         "; from its start and {} nearby at the same step: topple stands one up by at least {:.2}°, native Rapier rocks one back by at most {:.2}° and drops up to {}",
-                        super::scene::NEARBY_RUNS,
+                        super::observe::NEARBY_RUNS,
                         r.topple_least.to_degrees(),
                         r.native_most.to_degrees(),
                         r.native_drop

@@ -93,8 +93,9 @@ pub struct NearbyRuns {
     pub native: Vec<f64>,
 }
 
-/// How many nearby starts a chaotic-looking scene is run from.
-pub const NEARBY_RUNS: usize = 6;
+// How many nearby starts a chaotic-looking scene is run from: the same
+// count as a row's, defined with the row's observations.
+pub use crate::stress::observe::NEARBY_RUNS;
 
 /// The velocity step between nearby starts (m/s, scaled by the scene's
 /// units per metre): far below anything a game resolves, far above
