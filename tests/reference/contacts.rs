@@ -7,7 +7,9 @@
 
 use topple::domino::{ChainReport, Preset, RowSpec};
 use topple::reference::{run, run_from, Settings};
-use topple::stress::{draw, run_combo, violations, RowWatch, StressEngine, SweepSpec};
+use topple::stress::{
+    draw, run_combo, violations, Combo, Observation, RowWatch, StressEngine, SweepSpec,
+};
 
 #[test]
 fn heel_contacts_keep_sliding_blocks_apart() {
@@ -247,19 +249,27 @@ fn combos_2765_and_2800_of_the_full_sweep_run_clean() {
 #[test]
 fn combos_1700_and_2220_of_the_full_sweeps_hold_their_resting_contacts() {
     for (seed, index) in [(3, 1700), (2, 2220)] {
-        let spec = SweepSpec::full(seed);
-        let c = draw(seed, index, spec.n_lo, spec.n_hi);
-        assert_eq!(c.engine, StressEngine::Reference);
-        let o = run_combo(&c, 120.0);
-        let v = violations(&c, &o);
-        println!(
-            "seed {seed} combo {index}: {} hits of {}, {} impacts, overlap {:.3e} h, {:.1} s of CPU",
-            o.hits, c.row.n, o.audit.impacts, o.penetration, o.cpu
-        );
-        assert!(v.is_empty(), "combo {index}: {v:?}");
-        assert!(!o.over_budget, "combo {index}");
+        let (c, o) = run_clean(seed, index);
         assert!(o.hits >= c.row.n / 2, "combo {index}: {} hits", o.hits);
     }
+}
+
+/// Draws combination `index` of the full sweep of `seed` (a reference
+/// row), runs it as the sweep does and checks that it passes every check
+/// of the sweep within its budget of 120 s of CPU.
+fn run_clean(seed: u64, index: usize) -> (Combo, Observation) {
+    let spec = SweepSpec::full(seed);
+    let c = draw(seed, index, spec.n_lo, spec.n_hi);
+    assert_eq!(c.engine, StressEngine::Reference);
+    let o = run_combo(&c, 120.0);
+    let v = violations(&c, &o);
+    println!(
+        "seed {seed} combo {index}: {} hits of {}, {} impacts, overlap {:.3e} h, {:.1} s of CPU",
+        o.hits, c.row.n, o.audit.impacts, o.penetration, o.cpu
+    );
+    assert!(v.is_empty(), "combo {index}: {v:?}");
+    assert!(!o.over_budget, "combo {index}");
+    (c, o)
 }
 
 /// Combo 140 of the full sweep's seed 2 (Domino X, s/h 0.136, 18 blocks,
@@ -277,19 +287,8 @@ fn combos_1700_and_2220_of_the_full_sweeps_hold_their_resting_contacts() {
 /// overlap watch from the poses alone) with the wave through every block.
 #[test]
 fn combo_140_of_the_second_full_sweep_runs_through_its_leaning_train() {
-    let (seed, index) = (2, 140);
-    let spec = SweepSpec::full(seed);
-    let c = draw(seed, index, spec.n_lo, spec.n_hi);
-    assert_eq!(c.engine, StressEngine::Reference);
+    let (c, o) = run_clean(2, 140);
     assert_eq!((c.row.n, c.row.params.e1, c.row.params.e2), (18, 0.0, 0.0));
-    let o = run_combo(&c, 120.0);
-    let v = violations(&c, &o);
-    println!(
-        "seed {seed} combo {index}: {} hits of {}, {} impacts, overlap {:.3e} h, {:.1} s of CPU",
-        o.hits, c.row.n, o.audit.impacts, o.penetration, o.cpu
-    );
-    assert!(v.is_empty(), "{v:?}");
-    assert!(!o.over_budget);
     assert_eq!(o.hits, c.row.n, "the wave reaches the last block");
 }
 
