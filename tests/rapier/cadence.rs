@@ -36,13 +36,7 @@ fn run(mut topple: ToppleRapier, per_frame: usize, iterations: usize) -> Run {
     let mut world = PhysicsWorld::default();
     world.integration_parameters.dt = FRAME / per_frame as f64;
     world.integration_parameters.num_solver_iterations = iterations;
-    let wood = topple.add_material(PairMaterial::from_table(
-        ContactMaterial::hertz(1e8),
-        0.5, // μ
-        0.6, // μ_s
-        0.3, // e
-        1.0, // impact friction factor
-    ));
+    let wood = super::stack::wood(&mut topple);
     let ice = topple.add_material(PairMaterial {
         impact: ContactMaterial::hertz(1e8).with_restitution(0.0),
         smooth_friction: 0.0,

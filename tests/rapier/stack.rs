@@ -3,7 +3,8 @@
 //! measured with parry's own contact query (independent of topple's pass
 //! and of Rapier's solver).
 
-use topple::coupling::MaterialId;
+use topple::coupling::{MaterialId, PairMaterial};
+use topple::impact::ContactMaterial;
 use topple::rapier::f64::ToppleRapier;
 use topple::rapier2d_f64::parry::query;
 use topple::rapier2d_f64::prelude::*;
@@ -12,6 +13,18 @@ use topple::rapier2d_f64::prelude::*;
 pub const HALF: f64 = 0.05;
 /// Boxes in the column.
 pub const LEVELS: usize = 4;
+
+/// The column's material: Hertz stiffness 10⁸ N/m^1.5, μ 0.5, μ_s 0.6,
+/// e 0.3, impact friction factor 1.
+pub fn wood(topple: &mut ToppleRapier) -> MaterialId {
+    topple.add_material(PairMaterial::from_table(
+        ContactMaterial::hertz(1e8),
+        0.5,
+        0.6,
+        0.3,
+        1.0,
+    ))
+}
 
 /// What a run of a column shows.
 #[derive(Debug, Default)]

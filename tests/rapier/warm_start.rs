@@ -41,13 +41,7 @@ fn run_with(topple_mode: bool, ratio: f64, levels: usize, ball_e: f64) -> Run {
     } else {
         ToppleRapier::native()
     };
-    let wood = topple.add_material(PairMaterial::from_table(
-        ContactMaterial::hertz(1e8),
-        0.5, // μ
-        0.6, // μ_s
-        0.3, // e
-        1.0, // impact friction factor
-    ));
+    let wood = super::stack::wood(&mut topple);
     let rubber = topple.add_material(PairMaterial::from_table(
         ContactMaterial::hertz(1e8),
         0.5,
