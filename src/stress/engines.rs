@@ -82,8 +82,12 @@ fn native_rock_back(c: &Combo, seen: &Observation, budget: f64) -> Option<Native
         let mut near = c.clone();
         near.row.push = c.row.push + k as f64 * ROW_NEARBY_PUSH;
         if k > 0 {
+            // a nearby run of topple's that failed or ran over its budget
+            // says nothing of its rock-back: it cannot excuse the drop
             let t = run(&near, ImpactResponse::Topple)?;
-            r.topple_least = r.topple_least.min(t.stood_up_rock_back);
+            if t.error.is_none() && !t.over_budget {
+                r.topple_least = r.topple_least.min(t.stood_up_rock_back);
+            }
         }
         let n =
             run(&near, ImpactResponse::Native).filter(|n| n.error.is_none() && !n.over_budget)?;
