@@ -7,7 +7,7 @@
 //! | item | file | role |
 //! | --- | --- | --- |
 //! | [`draw_scene`], [`SceneCombo`], [`SHAPES`] | `draw.rs` | the seeded draw of one scene |
-//! | [`run_scene_combo`], [`SceneObservation`] | `run.rs` | one scene through its engine, watched, and again for its bits |
+//! | [`run_scene_combo`], [`SceneObservation`], [`SoftSag`], [`native_as_topple`] | `run.rs` | one scene through its engine, watched, and again for its bits; the soft contact's sag and native Rapier as topple steps it, the baselines of its depth |
 //! | [`scene_sweep`], [`scene_table`], [`scene_violations`] | `mod.rs` | many scenes in parallel; the violations and the table |
 //!
 //! ```no_run
@@ -25,7 +25,10 @@ use std::collections::BTreeMap;
 use crate::par::prelude::*;
 
 pub use draw::{draw_scene, SceneCombo, SceneEngine, SceneKind, StressShape, SHAPES};
-pub use run::{run_scene_combo, NearbyRuns, SceneObservation, NEARBY_RUNS, NEARBY_STEP};
+pub use run::{
+    native_as_topple, run_scene_combo, NearbyRuns, SceneObservation, SoftSag, NEARBY_RUNS,
+    NEARBY_STEP,
+};
 
 use super::sweep::{Kind, Violation};
 use super::StressEngine;
@@ -92,10 +95,11 @@ pub mod tolerance {
     pub const ENERGY_GAIN: f64 = 1e-9;
     /// Applied against recomputed velocities, over the speed scale.
     pub const IMPULSES: f64 = 1e-6;
-    /// Largest overlap of two bodies beyond one step's closing, over the
-    /// smaller one's least width (`SceneObservation::penetration_excess`):
-    /// Rapier's soft contacts let a heavy body sink into a light one under
-    /// load (mass ratios up to 10⁴ here); 0.1 is twice the rows' 0.05 h.
+    /// Largest overlap of two bodies beyond one step's closing and the soft
+    /// contact's sag under its load ([`super::SoftSag`]), over the smaller
+    /// one's least width (`SceneObservation::penetration_excess`): Rapier's
+    /// soft contacts let a heavy body sink into a light one under load (mass
+    /// ratios up to 10⁴ here), by the sag; 0.1 is twice the rows' 0.05 h.
     pub const PENETRATION: f64 = 0.1;
     /// Impact work of one frame at most for the soak (impulse steps ×
     /// contact points, summed over the frame's impacts); the scene family
@@ -112,9 +116,9 @@ pub fn frame_budget(c: &SceneCombo) -> Option<u64> {
 /// A topple run beyond the overlap tolerance or through the ground, but no
 /// worse than native Rapier on the same scene: reported, not counted. For
 /// the overlap, "no worse" reads [`SceneObservation::topple_depth`] against
-/// [`SceneObservation::native_depth`] (a scene run again from nearby starts
-/// when topple's run was deeper: topple's shallowest against native's
-/// deepest).
+/// [`SceneObservation::native_depth`] (a scene run again from nearby starts,
+/// and by native Rapier as topple configures and steps it, when topple's run
+/// was deeper: topple's shallowest against native's deepest).
 pub fn within_native(c: &SceneCombo, o: &SceneObservation) -> bool {
     !c.engine.is_baseline()
         && o.native.is_some_and(|(_, through)| {
@@ -123,8 +127,9 @@ pub fn within_native(c: &SceneCombo, o: &SceneObservation) -> bool {
         })
 }
 
-/// topple's overlap is deeper than native Rapier's on the same scene (from
-/// every nearby start, when the scene was run again from them); false
+/// topple's overlap beyond the soft contact's sag is deeper than native
+/// Rapier's on the same scene (from every nearby start, and than native
+/// as topple configures and steps it, when the scene was run again); false
 /// without a native run.
 fn deeper_than_native(o: &SceneObservation) -> bool {
     o.native_depth().is_some_and(|n| o.topple_depth() > n)
@@ -200,10 +205,11 @@ fn describe_nearby(n: &NearbyRuns) -> String {
         }
     };
     format!(
-        "; from {} nearby starts: topple {}, native {}",
+        "; from {} nearby starts: topple {}, native {}; native as topple configures and steps it {}",
         NEARBY_RUNS,
         range(&n.topple),
-        range(&n.native)
+        range(&n.native),
+        range(&n.native_as_topple)
     )
 }
 
@@ -459,7 +465,7 @@ pub fn scene_table(spec: &SceneSpec, r: &SceneSweepReport) -> String {
             Kind::EnergyGain => format!("{:.0e}", tolerance::ENERGY_GAIN),
             Kind::Impulses => format!("{:.0e}", tolerance::IMPULSES),
             Kind::Penetration => format!(
-                "{} of the least width beyond one step's closing, and for topple deeper than native",
+                "{} of the least width beyond one step's closing and the soft contact's sag, and for topple deeper than native as drawn and as topple steps it",
                 tolerance::PENETRATION
             ),
             Kind::ThroughGround => "centre below the ground unless one step's closing reaches it, and for topple not in native".into(),

@@ -18,13 +18,20 @@ pub struct SceneObservation {
     /// Largest overlap of two bodies, or of a body and the ground or a
     /// wall, over the smaller body's least width.
     pub penetration: f64,
+    /// Largest overlap beyond the soft contact's sag ([`SoftSag`]), over the
+    /// smaller body's least width: (depth − S) / w, no allowance for speed.
+    /// The measure topple's run and native Rapier's are compared by (both
+    /// runs have the same bodies, so the same S).
+    pub beyond_sag: f64,
     /// Where and when the largest overlap was.
     pub penetration_at: String,
-    /// Largest overlap beyond one step's closing, over the smaller body's
-    /// least width: (depth − Δt (ŝ_a + ŝ_b)) / w, where ŝ is the fastest a
-    /// body has moved so far (|v| + |ω| R, R its bounding radius) and a
-    /// body against the ground or a wall counts alone. What the scene
-    /// family checks ([`super::tolerance::PENETRATION`]).
+    /// Largest overlap beyond one step's closing and the soft contact's sag,
+    /// over the smaller body's least width: (depth − Δt (ŝ_a + ŝ_b) − S) / w,
+    /// where ŝ is the fastest a body has moved so far (|v| + |ω| R, R its
+    /// bounding radius), a body against the ground or a wall counts alone,
+    /// and S is the depth at which Rapier's soft contact holds the heaviest
+    /// load the pair can carry ([`SoftSag`]). What the scene family checks
+    /// ([`super::tolerance::PENETRATION`]).
     pub penetration_excess: f64,
     /// Where and when the largest excess was.
     pub penetration_excess_at: String,
@@ -37,8 +44,9 @@ pub struct SceneObservation {
     /// detection; reported, not counted).
     pub tunnelled: usize,
     /// The same scene with native Rapier (a topple scene only): its largest
-    /// overlap over the least width (`penetration`, without allowance: the
-    /// allowance follows each run's own speeds) and whether the centre of a
+    /// overlap beyond the soft contact's sag over the least width
+    /// (`beyond_sag`, without the allowance for speed: that follows each
+    /// run's own speeds) and whether the centre of a
     /// body went below the ground (also without allowance: counted or
     /// tunnelled).
     pub native: Option<(f64, bool)>,
@@ -82,15 +90,69 @@ pub struct SceneObservation {
 /// is chaotic: one run of topple against one of native compares two draws
 /// of motions that differ from the first impact on. The scene check then
 /// counts a topple overlap only when it is deeper than native's from every
-/// start tried: topple's shallowest depth against native's deepest
-/// (docs/stress.md, "Chaotic scenes").
+/// start tried: topple's shallowest depth against native's deepest, native's
+/// including its runs as topple configures and steps it (docs/stress.md,
+/// "Chaotic scenes" and "The scene family's baseline stepped as topple
+/// steps it").
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct NearbyRuns {
-    /// topple's deepest overlap over the least width, one per nearby start.
+    /// topple's deepest overlap beyond the soft contact's sag over the least
+    /// width (`beyond_sag`), one per nearby start.
     pub topple: Vec<f64>,
     /// Native Rapier's, one per nearby start (a start it cannot run is left
     /// out).
     pub native: Vec<f64>,
+    /// Native Rapier configured and stepped as topple configures and steps
+    /// it, without topple's impacts ([`native_as_topple`]), from the drawn
+    /// start and every nearby one: one depth per run, as `native`.
+    pub native_as_topple: Vec<f64>,
+}
+
+/// The scene as native Rapier runs it under topple, without topple's
+/// impacts: what topple changes in Rapier besides its impacts, each
+/// combination as one native scene. Restitution 0 on every material and
+/// pair (topple leaves every contact it does not resolve to Rapier at
+/// e = 0, docs/model.md §9: a topple run with no impacts is native Rapier
+/// at e = 0, `tests/rapier/stress_checks.rs`,
+/// `the_pair_hook_alone_is_native_rapier_with_restitution_zero`), and each
+/// frame of Δt taken in topple's k pieces (k = ⌈Δt / max_substep⌉, the
+/// adapter's sub-steps), solved in Rapier's N substeps per piece (the
+/// bodies topple raises, which turn) or in max(1, round(N / k)) (the
+/// others: Rapier's substep kept at the frame's). Rapier's soft-contact
+/// depth on a settling stack moves with the step by up to half
+/// (docs/stress.md, "The scene family's baseline stepped as topple steps
+/// it"), so native Rapier at the frame's step alone is not the depth
+/// Rapier gives topple's pieces.
+pub fn native_as_topple(scene: &Scene) -> Vec<Scene> {
+    let mut resting = scene.clone();
+    for m in &mut resting.materials {
+        m.restitution = 0.0;
+    }
+    for p in &mut resting.pairs {
+        p.law.restitution = 0.0;
+    }
+    let dt = scene.solver.dt;
+    let length_unit = scene.solver.length_unit.unwrap_or(1.0);
+    let pieces = crate::rapier::scene::topple_settings(&scene.solver, length_unit)
+        .max_substep
+        .filter(|&h| h > 0.0 && dt > h)
+        // the adapter's count (`ToppleRapier::substeps`), with its allowance
+        // for f32's rounding of Δt
+        .map_or(1, |h| ((dt / h) * (1.0 - 1e-6)).ceil().min(1e3) as usize);
+    let mut out = vec![resting.clone()];
+    if pieces > 1 {
+        let n = scene.solver.iterations;
+        let kept = ((n as f64 / pieces as f64).round() as usize).max(1);
+        for base in [scene, &resting] {
+            for iterations in [n, kept] {
+                let mut s = base.clone();
+                s.solver.dt = dt / pieces as f64;
+                s.solver.iterations = iterations;
+                out.push(s);
+            }
+        }
+    }
+    out
 }
 
 // How many nearby starts a chaotic-looking scene is run from: the same
@@ -107,20 +169,104 @@ impl SceneObservation {
     /// topple's depth as the scene check reads it: the run's own, or the
     /// shallowest of it and its nearby runs when the scene was run again.
     pub fn topple_depth(&self) -> f64 {
-        self.nearby.as_ref().map_or(self.penetration, |n| {
-            n.topple.iter().fold(self.penetration, |a, &b| a.min(b))
+        self.nearby.as_ref().map_or(self.beyond_sag, |n| {
+            n.topple.iter().fold(self.beyond_sag, |a, &b| a.min(b))
         })
     }
 
     /// Native Rapier's depth as the scene check reads it: its run's, or the
-    /// deepest of it and its nearby runs; `None` without a native run.
+    /// deepest of it, its nearby runs and its runs as topple configures and
+    /// steps it; `None` without a native run.
     pub fn native_depth(&self) -> Option<f64> {
         let (pen, _) = self.native?;
-        Some(
-            self.nearby
-                .as_ref()
-                .map_or(pen, |n| n.native.iter().fold(pen, |a, &b| a.max(b))),
-        )
+        Some(self.nearby.as_ref().map_or(pen, |n| {
+            n.native
+                .iter()
+                .chain(&n.native_as_topple)
+                .fold(pen, |a, &b| a.max(b))
+        }))
+    }
+}
+
+/// The depth at which Rapier's soft contact holds a load: a contact of
+/// projected mass m carrying a force F settles at F / (m ω²) whatever the
+/// step length (ω = 2π f, f the contact's natural frequency; derived in
+/// docs/stress.md, "Rapier's soft contact at a shorter step", and measured
+/// against native Rapier in `tests/rapier/soft_contact.rs`). Between a lower
+/// body l and an upper body u the load is at most the weight of every
+/// dynamic body of the scene but l (l carries the rest; a fixed body
+/// carries everything), and 1/m ≤ 1/m_l + 1/m_u (the translational part of
+/// the projected mass). So
+///
+///   S = g (M − m_l) (1/m_l + 1/m_u) / ω²,
+///
+/// with a fixed body's 1/m = 0 and its share of M none, and ω the
+/// contact's own (Rapier's `static_contact_softness` when one side is
+/// fixed, `contact_softness` otherwise). Units: the scene's length unit (g
+/// in units/s², S in units). It is the closed form of one contact under
+/// the heaviest load it could carry. Balls follow it; boxes (two points a
+/// contact) sink up to 14 % more under light loads and far less under heavy
+/// ones (0.66 and 0.37 of it in the test), so it is an allowance from above
+/// (`tests/rapier/stress_checks.rs`,
+/// `the_soft_contacts_allowance_bounds_native_rapiers_depth_from_above`).
+///
+/// ```
+/// use std::f64::consts::PI;
+/// use topple::stress::scene::SoftSag;
+/// // 1 kg on 3 kg on the ground, g = 9.81 m/s², 30 Hz between the bodies
+/// let (w30, w60) = (2.0 * PI * 30.0, 2.0 * PI * 60.0);
+/// let s = SoftSag::new(9.81, w30, w60, vec![Some(3.0), Some(1.0)]);
+/// // the upper box's weight on the pair: 1 kg × g (1/3 + 1/1) / ω²
+/// assert!((s.pair(0, 1) - 9.81 * (4.0 / 3.0) / (w30 * w30)).abs() < 1e-15);
+/// // both boxes' weight on the ground, through the lower box
+/// assert!((s.ground(0) - 9.81 * 4.0 / 3.0 / (w60 * w60)).abs() < 1e-15);
+/// ```
+#[derive(Clone, Debug, PartialEq)]
+pub struct SoftSag {
+    /// |g| (units/s²).
+    g: f64,
+    /// ω between two dynamic bodies (rad/s).
+    omega: f64,
+    /// ω against a fixed body (rad/s).
+    omega_fixed: f64,
+    /// Each body's mass (kg), `None` when it is fixed.
+    masses: Vec<Option<f64>>,
+    /// Σ of the dynamic masses (kg).
+    total: f64,
+}
+
+impl SoftSag {
+    /// The sag of a scene with gravity `g` (units/s²), contact angular
+    /// frequencies `omega` (rad/s, two dynamic bodies) and `omega_fixed`
+    /// (one side fixed), and its bodies' `masses` (`None`: fixed).
+    pub fn new(g: f64, omega: f64, omega_fixed: f64, masses: Vec<Option<f64>>) -> Self {
+        let total = masses.iter().flatten().sum();
+        SoftSag {
+            g,
+            omega,
+            omega_fixed,
+            masses,
+            total,
+        }
+    }
+
+    /// Body `i`'s inverse mass and share of the load (a fixed body: 0, 0).
+    fn body(&self, i: usize) -> (f64, f64) {
+        self.masses[i].map_or((0.0, 0.0), |m| (1.0 / m, m))
+    }
+
+    /// S between body `lower` and body `upper` resting on it (units).
+    pub fn pair(&self, lower: usize, upper: usize) -> f64 {
+        let ((inv_l, m_l), (inv_u, _)) = (self.body(lower), self.body(upper));
+        let fixed = self.masses[lower].is_none() || self.masses[upper].is_none();
+        let omega = if fixed { self.omega_fixed } else { self.omega };
+        self.g * (self.total - m_l) * (inv_l + inv_u) / (omega * omega)
+    }
+
+    /// S between body `i` and the fixed ground (units).
+    pub fn ground(&self, i: usize) -> f64 {
+        let (inv_i, _) = self.body(i);
+        self.g * self.total * inv_i / (self.omega_fixed * self.omega_fixed)
     }
 }
 
@@ -165,8 +311,8 @@ pub fn run_scene_combo(c: &SceneCombo, budget: f64) -> SceneObservation {
         // (topple's run gets the allowance, the baseline does not excuse its
         // own: both are native Rapier's behaviour on this scene)
         let below = native.through_ground.is_some() || native.tunnelled > 0;
-        seen.native = (native.error.is_none()).then_some((native.penetration, below));
-        let deeper = seen.native.is_some_and(|(pen, _)| seen.penetration > pen);
+        seen.native = (native.error.is_none()).then_some((native.beyond_sag, below));
+        let deeper = seen.native.is_some_and(|(pen, _)| seen.beyond_sag > pen);
         if deeper && seen.penetration_excess > super::tolerance::PENETRATION && !seen.over_budget {
             seen.nearby = Some(nearby_runs(c, budget));
         }
@@ -178,20 +324,23 @@ pub fn run_scene_combo(c: &SceneCombo, budget: f64) -> SceneObservation {
 /// by native Rapier (overlaps watched, each run within `budget`).
 fn nearby_runs(c: &SceneCombo, budget: f64) -> NearbyRuns {
     let mut out = NearbyRuns::default();
-    for k in 1..=NEARBY_RUNS {
+    let depth = |scene: &Scene, engine| {
+        let o = run_whole(scene, engine, c.precision, true, budget);
+        (o.error.is_none() && !o.over_budget).then_some(o.beyond_sag)
+    };
+    for k in 0..=NEARBY_RUNS {
         let mut scene = c.scene.clone();
         let dv = k as f64 * NEARBY_STEP * c.unit;
         for b in &mut scene.bodies {
             b.velocity[0] += dv;
         }
-        for (engine, depths) in [
-            (c.rapier_engine(), &mut out.topple),
-            (ImpactResponse::Native, &mut out.native),
-        ] {
-            let o = run_whole(&scene, engine, c.precision, true, budget);
-            if o.error.is_none() && !o.over_budget {
-                depths.push(o.penetration);
-            }
+        if k > 0 {
+            out.topple.extend(depth(&scene, c.rapier_engine()));
+            out.native.extend(depth(&scene, ImpactResponse::Native));
+        }
+        for s in native_as_topple(&scene) {
+            out.native_as_topple
+                .extend(depth(&s, ImpactResponse::Native));
         }
     }
     out
@@ -283,6 +432,23 @@ macro_rules! watcher_for {
                 let sizes: Vec<f64> = handles.iter().map(|h| least_width(&sw, h.1)).collect();
                 let radii: Vec<f64> =
                     handles.iter().map(|h| bounding_radius(&sw, h.1)).collect();
+                let sag = {
+                    let p = &sw.world.integration_parameters;
+                    let omega = |f: f64| 2.0 * std::f64::consts::PI * f;
+                    let masses = handles
+                        .iter()
+                        .map(|(h, _)| {
+                            let rb = &sw.world.bodies[*h];
+                            rb.is_dynamic().then(|| f64::from(rb.mass()))
+                        })
+                        .collect();
+                    super::SoftSag::new(
+                        f64::from(sw.world.gravity.length()),
+                        omega(f64::from(p.contact_softness.natural_frequency)),
+                        omega(f64::from(p.static_contact_softness.natural_frequency)),
+                        masses,
+                    )
+                };
                 // the fastest each body has moved (|v| + |ω| R), from its start
                 let mut fastest = vec![0.0f64; handles.len()];
                 let dt = scene.solver.dt;
@@ -381,6 +547,7 @@ macro_rules! watcher_for {
                             handles: &handles,
                             sizes: &sizes,
                             closing: &fastest,
+                            sag: &sag,
                             dt,
                         };
                         overlaps(&sw, &bodies, ground, time, &mut seen);
@@ -411,13 +578,16 @@ macro_rules! watcher_for {
                 sizes: &'a [f64],
                 /// The fastest each body has moved so far (|v| + |ω| R).
                 closing: &'a [f64],
+                /// The depth Rapier's soft contact holds each pair's load at.
+                sag: &'a super::SoftSag,
                 /// Time step (s).
                 dt: f64,
             }
 
             /// Every pair of bodies whose boxes meet, and every body against
             /// the ground: the deepest overlap over the smaller least width,
-            /// and the deepest beyond one step's closing.
+            /// and the deepest beyond one step's closing and the soft
+            /// contact's sag.
             fn overlaps(
                 sw: &SceneWorld,
                 b: &Bodies,
@@ -427,22 +597,30 @@ macro_rules! watcher_for {
             ) {
                 let (handles, sizes) = (b.handles, b.sizes);
                 let w = &sw.world;
+                // each centre's height against gravity
+                let up = -w.gravity.normalize_or_zero();
+                let heights: Vec<f64> = handles
+                    .iter()
+                    .map(|(h, _)| f64::from(w.bodies[*h].translation().dot(up)))
+                    .collect();
                 let aabbs: Vec<_> = handles
                     .iter()
                     .map(|(_, col)| w.colliders[*col].compute_aabb())
                     .collect();
-                let mut note = |depth: f64, size: f64, closing: f64, what: String| {
+                let mut note = |depth: f64, size: f64, closing: f64, sag: f64, what: String| {
                     let d = depth / size;
                     if d > seen.penetration {
                         seen.penetration = d;
                         seen.penetration_at = format!("{what} at t = {time:.3} s");
                     }
-                    let excess = (depth - b.dt * closing) / size;
+                    seen.beyond_sag = seen.beyond_sag.max((depth - sag) / size);
+                    let excess = (depth - b.dt * closing - sag) / size;
                     if excess > seen.penetration_excess {
                         seen.penetration_excess = excess;
                         seen.penetration_excess_at = format!(
-                            "{what} at t = {time:.3} s, {d:.3} deep, one step's closing {:.3}",
-                            b.dt * closing / size
+                            "{what} at t = {time:.3} s, {d:.3} deep, one step's closing {:.3}, soft contact's sag {:.3}",
+                            b.dt * closing / size,
+                            sag / size
                         );
                     }
                 };
@@ -453,10 +631,13 @@ macro_rules! watcher_for {
                         }
                         let gap = signed_gap(&w.bodies, &w.colliders, handles[i].1, handles[j].1);
                         if gap < 0.0 {
+                            // the lower centre (against gravity) carries the other
+                            let (lower, upper) = if heights[i] <= heights[j] { (i, j) } else { (j, i) };
                             note(
                                 -gap,
                                 sizes[i].min(sizes[j]),
                                 b.closing[i] + b.closing[j],
+                                b.sag.pair(lower, upper),
                                 format!("b{}/b{}", i + 1, j + 1),
                             );
                         }
@@ -464,7 +645,13 @@ macro_rules! watcher_for {
                     if let Some(gr) = ground {
                         let gap = signed_gap(&w.bodies, &w.colliders, gr, handles[i].1);
                         if gap < 0.0 {
-                            note(-gap, sizes[i], b.closing[i], format!("b{}/ground", i + 1));
+                            note(
+                                -gap,
+                                sizes[i],
+                                b.closing[i],
+                                b.sag.ground(i),
+                                format!("b{}/ground", i + 1),
+                            );
                         }
                     }
                 }
