@@ -597,7 +597,7 @@ fn the_soft_contacts_allowance_bounds_native_rapiers_depth_from_above() {
     let width = |size: Option<[f64; 2]>| size.map_or(f64::INFINITY, |s| s[0].min(s[1]));
     let w = width(c.scene.bodies[0].size).min(width(c.scene.bodies[1].size));
     // (depth, closed form), the bottom body as drawn and with the masses swapped
-    let mut sink = |swap: bool| {
+    let sink = |swap: bool| {
         let mut c = c.clone();
         if swap {
             let (a, b) = (c.scene.bodies[0].mass, c.scene.bodies[1].mass);
