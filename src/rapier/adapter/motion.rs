@@ -328,6 +328,44 @@ mod tests {
     }
 
     #[test]
+    fn a_later_piece_carries_the_pose_the_pass_read_and_only_that_piece() {
+        use super::super::backend::prelude::{
+            ColliderBuilder, PhysicsWorld, RigidBodyBuilder, Vector,
+        };
+        let mut world = PhysicsWorld::default();
+        let (h, _) = world.insert(
+            RigidBodyBuilder::dynamic()
+                .translation(Vector::new(1.0, 2.0))
+                .rotation(0.5),
+            ColliderBuilder::ball(0.1),
+        );
+        world.step(); // Rapier lists the body as awake after a step
+        let read = com_and_angle(&world.bodies[h]);
+        let mut m = Motion::default();
+        let start = |m: &Motion| (m.starts()[0].1, m.starts()[0].2);
+        m.record_start(&world.islands, &world.bodies, false);
+        assert_eq!(start(&m), read);
+        // the pass notes another pose (as after Rapier's step): carried once
+        m.note_end(h, [3.0, 4.0], 0.25);
+        m.record_start(&world.islands, &world.bodies, true);
+        assert_eq!(start(&m), ([3.0, 4.0], 0.25));
+        // no pass in between, or a new step: read from Rapier again
+        m.record_start(&world.islands, &world.bodies, true);
+        assert_eq!(start(&m), read);
+        m.note_end(h, [3.0, 4.0], 0.25);
+        m.record_start(&world.islands, &world.bodies, false);
+        assert_eq!(start(&m), read);
+        // an impact of the pass moved the body: read again
+        m.note_end(h, [3.0, 4.0], 0.25);
+        m.begin_pass(0.01);
+        m.path(h, &world.bodies[h])
+            .restart(0.0, 0.01, [1.0, 0.0], 0.0);
+        m.forget_changed_ends();
+        m.record_start(&world.islands, &world.bodies, true);
+        assert_eq!(start(&m), read);
+    }
+
+    #[test]
     fn angles_unwrap_across_pi() {
         let a = unwrap_near(3.1, -3.1);
         assert!((a - (3.1 - std::f64::consts::TAU)).abs() < 1e-12);
