@@ -30,6 +30,14 @@ pub(crate) struct Cadence {
     /// Bodies an impact changed since the last piece: woken, but listed in
     /// Rapier's active set only after its next step.
     struck: Vec<RigidBodyHandle>,
+    /// The reach of each body's colliders from its centre of mass (m), by
+    /// arena index, with the body and the step it was measured in: read
+    /// once per step, not once per piece (an app changes shapes only
+    /// between steps).
+    reach: Vec<(f64, Option<RigidBodyHandle>, u64)>,
+    /// The stamp of the current step (one more at every `restore` that ends
+    /// a step).
+    step: u64,
 }
 
 impl Cadence {
@@ -95,7 +103,11 @@ impl Cadence {
         let Some(rb) = bodies.get(h) else { return };
         // a body met twice (awake and struck) has `extra` already
         let own = rb.additional_solver_iterations();
-        if !rb.is_dynamic() || own >= extra || turning_speed(rb, colliders) <= threshold {
+        if !rb.is_dynamic() || own >= extra {
+            return;
+        }
+        let w = f64::from(rb.angvel()).abs();
+        if w == 0.0 || w * self.reach_of(h, rb, colliders) <= threshold {
             return;
         }
         if let Some(rb) = bodies.get_mut(h) {
@@ -104,13 +116,35 @@ impl Cadence {
         }
     }
 
+    /// [`reach`] of body `h`, measured once per step.
+    fn reach_of(&mut self, h: RigidBodyHandle, rb: &RigidBody, colliders: &ColliderSet) -> f64 {
+        let i = h.into_raw_parts().0 as usize;
+        if self.reach.len() <= i {
+            self.reach.resize(i + 1, (0.0, None, 0));
+        }
+        let (r, of, step) = &mut self.reach[i];
+        if *of != Some(h) || *step != self.step {
+            *r = reach(rb, colliders);
+            *of = Some(h);
+            *step = self.step;
+        }
+        *r
+    }
+
     /// Notes the bodies an impact of the last pass changed.
     pub fn note_struck(&mut self, struck: impl Iterator<Item = RigidBodyHandle>) {
         self.struck.extend(struck);
     }
 
-    /// Gives every raised body its own count back (at the end of a step).
-    pub fn restore(&mut self, bodies: &mut RigidBodySet) {
+    /// Gives every raised body its own count back at the end of a step;
+    /// the next step measures the bodies' reach again.
+    pub fn end_step(&mut self, bodies: &mut RigidBodySet) {
+        self.restore(bodies);
+        self.step = self.step.wrapping_add(1).max(1);
+    }
+
+    /// Gives every raised body its own count back.
+    fn restore(&mut self, bodies: &mut RigidBodySet) {
         for (h, own) in self.raised.drain(..) {
             if let Some(rb) = bodies.get_mut(h) {
                 rb.set_additional_solver_iterations(own);
@@ -119,16 +153,11 @@ impl Cadence {
     }
 }
 
-/// How fast a body's points turn about its centre of mass (world units/s):
-/// |ω| times the farthest reach of its colliders from the centre of mass.
-fn turning_speed(rb: &RigidBody, colliders: &ColliderSet) -> f64 {
-    let w = f64::from(rb.angvel()).abs();
-    if w == 0.0 {
-        return 0.0;
-    }
+/// The farthest reach of a body's colliders from its centre of mass (world
+/// units): |ω| times it is how fast the body's points turn (world units/s).
+fn reach(rb: &RigidBody, colliders: &ColliderSet) -> f64 {
     let com = rb.local_center_of_mass();
-    let reach = rb
-        .colliders()
+    rb.colliders()
         .iter()
         .filter_map(|&c| colliders.get(c))
         .map(|co| {
@@ -137,6 +166,5 @@ fn turning_speed(rb: &RigidBody, colliders: &ColliderSet) -> f64 {
                 .map_or(0.0, |p| f64::from((p.translation - com).length()));
             offset + f64::from(co.shape().compute_local_bounding_sphere().radius)
         })
-        .fold(0.0, f64::max);
-    w * reach
+        .fold(0.0, f64::max)
 }

@@ -18,7 +18,8 @@ use std::sync::Mutex;
 use super::backend::geometry::NEW_CONTACT_BIT;
 use super::backend::math::Real;
 use super::backend::prelude::{
-    ColliderHandle, ContactModificationContext, PhysicsHooks, RigidBodyHandle, SolverFlags, Vector,
+    ColliderHandle, ContactModificationContext, PhysicsHooks, RigidBody, RigidBodyHandle,
+    SolverFlags, Vector,
 };
 
 use super::support::{self, Notice};
@@ -200,12 +201,12 @@ impl ToppleHooks {
         }
         let n = *context.normal;
         let bodies = context.bodies;
-        let velocity = |h: Option<RigidBodyHandle>, p: Vector| {
-            h.and_then(|h| bodies.get(h))
-                .map(|rb| rb.velocity_at_point(p))
-                .unwrap_or_default()
+        // each body looked up once per pair, not once per point
+        let body = |h: Option<RigidBodyHandle>| h.and_then(|h| bodies.get(h));
+        let (b1, b2) = (body(context.rigid_body1), body(context.rigid_body2));
+        let velocity = |rb: Option<&RigidBody>, p: Vector| {
+            rb.map(|rb| rb.velocity_at_point(p)).unwrap_or_default()
         };
-        let (b1, b2) = (context.rigid_body1, context.rigid_body2);
         // Rapier pushed on the pair in its last step: stamp the frame
         if context.manifold.points.iter().any(|p| p.data.impulse > 0.0) {
             *context.user_data = self.frame;

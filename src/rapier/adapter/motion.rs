@@ -114,7 +114,18 @@ pub(crate) struct Motion {
     handles: Vec<RigidBodyHandle>,
     /// Paths are predictions: from the pose now, at the velocity now.
     predicting: bool,
+    /// The pose (centre of mass, angle) the pass read for each body at the
+    /// end of a piece, by arena index, with the stamp of that piece
+    /// (`STALE`: none, or an impact moved the body since): the next
+    /// piece's start pose, read once instead of twice (an `atan2` per body
+    /// and piece).
+    ends: Vec<(u64, [f64; 2], f64)>,
+    /// The stamp of the current piece (one more at every `record_start`).
+    piece: u64,
 }
+
+/// The stamp of an end pose that cannot be carried.
+const STALE: u64 = u64::MAX;
 
 const NONE: u32 = u32::MAX;
 
@@ -131,20 +142,49 @@ fn slot(map: &mut Vec<u32>, i: usize) -> &mut u32 {
 }
 
 impl Motion {
-    /// Records the poses of the awake bodies before Rapier's step.
-    pub fn record_start(&mut self, islands: &IslandManager, bodies: &RigidBodySet) {
+    /// Records the poses of the awake bodies before Rapier's step. With
+    /// `carry` (a later piece of the same step, nothing but topple's
+    /// impacts having moved a body since the last pass) a body's pose is
+    /// the one that pass read at the end of the last piece
+    /// ([`Motion::note_end`]), the same bits read again.
+    pub fn record_start(&mut self, islands: &IslandManager, bodies: &RigidBodySet, carry: bool) {
         for &(h, _, _) in &self.starts {
             self.start_of[index(h)] = NONE;
         }
         self.starts.clear();
+        let last = self.piece;
+        self.piece = self.piece.wrapping_add(1) % STALE;
         for h in islands.active_bodies() {
             let Some(rb) = bodies.get(h) else { continue };
             if !rb.is_dynamic() {
                 continue;
             }
-            let (com, angle) = com_and_angle(rb);
+            let (com, angle) = match self.ends.get(index(h)) {
+                Some(&(stamp, com, angle)) if carry && stamp == last => (com, angle),
+                _ => com_and_angle(rb),
+            };
             *slot(&mut self.start_of, index(h)) = self.starts.len() as u32;
             self.starts.push((h, com, angle));
+        }
+    }
+
+    /// Notes the pose (centre of mass, angle) the pass read for body `h`
+    /// after Rapier's step of the current piece.
+    pub fn note_end(&mut self, h: RigidBodyHandle, com: [f64; 2], angle: f64) {
+        let i = index(h);
+        if self.ends.len() <= i {
+            self.ends.resize(i + 1, (STALE, [0.0; 2], 0.0));
+        }
+        self.ends[i] = (self.piece, com, angle);
+    }
+
+    /// Forgets the end poses noted for the bodies an impact of this pass
+    /// changed: their poses are written again.
+    pub fn forget_changed_ends(&mut self) {
+        for (h, p) in self.handles.iter().zip(&self.paths) {
+            if let (true, Some(end)) = (p.changed, self.ends.get_mut(index(*h))) {
+                end.0 = STALE;
+            }
         }
     }
 
@@ -285,6 +325,44 @@ mod tests {
         assert!((c3[0] - (0.25 - 2.0 * 0.075)).abs() < 1e-15);
         assert!((c3[1] - 0.5).abs() < 1e-15);
         assert!((a3 - (0.125 + 0.075)).abs() < 1e-15);
+    }
+
+    #[test]
+    fn a_later_piece_carries_the_pose_the_pass_read_and_only_that_piece() {
+        use super::super::backend::prelude::{
+            ColliderBuilder, PhysicsWorld, RigidBodyBuilder, Vector,
+        };
+        let mut world = PhysicsWorld::default();
+        let (h, _) = world.insert(
+            RigidBodyBuilder::dynamic()
+                .translation(Vector::new(1.0, 2.0))
+                .rotation(0.5),
+            ColliderBuilder::ball(0.1),
+        );
+        world.step(); // Rapier lists the body as awake after a step
+        let read = com_and_angle(&world.bodies[h]);
+        let mut m = Motion::default();
+        let start = |m: &Motion| (m.starts()[0].1, m.starts()[0].2);
+        m.record_start(&world.islands, &world.bodies, false);
+        assert_eq!(start(&m), read);
+        // the pass notes another pose (as after Rapier's step): carried once
+        m.note_end(h, [3.0, 4.0], 0.25);
+        m.record_start(&world.islands, &world.bodies, true);
+        assert_eq!(start(&m), ([3.0, 4.0], 0.25));
+        // no pass in between, or a new step: read from Rapier again
+        m.record_start(&world.islands, &world.bodies, true);
+        assert_eq!(start(&m), read);
+        m.note_end(h, [3.0, 4.0], 0.25);
+        m.record_start(&world.islands, &world.bodies, false);
+        assert_eq!(start(&m), read);
+        // an impact of the pass moved the body: read again
+        m.note_end(h, [3.0, 4.0], 0.25);
+        m.begin_pass(0.01);
+        m.path(h, &world.bodies[h])
+            .restart(0.0, 0.01, [1.0, 0.0], 0.0);
+        m.forget_changed_ends();
+        m.record_start(&world.islands, &world.bodies, true);
+        assert_eq!(start(&m), read);
     }
 
     #[test]

@@ -326,7 +326,7 @@ impl ToppleRapier {
         let mut params = *parts.integration_parameters;
         let (mut now, mut k, mut splits, mut groups): (Real, usize, usize, usize) = (0.0, 0, 0, 0);
         loop {
-            self.begin_piece(&parts);
+            self.begin_piece(&parts, now > 0.0);
             let piece_end = boundary(k + 1);
             let ahead = self.predict(&parts, dt - now);
             let sub_step = ahead.moving_contact;
@@ -391,7 +391,7 @@ impl ToppleRapier {
                 splits = 0;
             }
         }
-        self.cadence.restore(parts.bodies);
+        self.cadence.end_step(parts.bodies);
         self.finish_step();
         groups
     }
@@ -459,8 +459,10 @@ impl ToppleRapier {
 
     /// Records the start poses of a piece of the step (the awake bodies, and
     /// the bodies added since the last step).
-    fn begin_piece(&mut self, parts: &StepParts<'_>) {
-        self.record_start(parts.islands, parts.bodies);
+    /// `later`: not the step's first piece (the poses the last pass read
+    /// are carried over).
+    fn begin_piece(&mut self, parts: &StepParts<'_>, later: bool) {
+        self.record_start(parts.islands, parts.bodies, later);
         if self.hooks.mode == ImpactResponse::Topple {
             for &b in &self.added {
                 self.pass.motion.record_added(parts.bodies, b);
@@ -534,13 +536,13 @@ impl ToppleRapier {
     ) {
         self.pass.clear_step();
         self.prepare(gravity, integration_parameters, 1);
-        self.record_start(islands, bodies);
+        self.record_start(islands, bodies, false);
     }
 
-    fn record_start(&mut self, islands: &IslandManager, bodies: &RigidBodySet) {
+    fn record_start(&mut self, islands: &IslandManager, bodies: &RigidBodySet, carry: bool) {
         if self.hooks.mode == ImpactResponse::Topple {
             let start = Instant::now();
-            self.pass.motion.record_start(islands, bodies);
+            self.pass.motion.record_start(islands, bodies, carry);
             self.stats.topple_seconds += start.elapsed().as_secs_f64();
         }
     }

@@ -74,6 +74,7 @@ impl ImpactPass {
         match start {
             Some((com0, angle0)) => {
                 let (com, angle) = super::super::motion::com_and_angle(rb);
+                self.motion.note_end(h, com, angle);
                 let moved =
                     (com[0] - com0[0]).hypot(com[1] - com0[1]) + (angle - angle0).abs() * radius;
                 moved.max(by_velocity)

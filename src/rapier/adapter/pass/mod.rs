@@ -284,6 +284,7 @@ impl ImpactPass {
     /// Writes the new velocities and end poses of every body an impact
     /// changed into Rapier (waking them).
     pub fn write_back(&mut self, bodies: &mut RigidBodySet) {
+        self.motion.forget_changed_ends();
         for (h, path) in self.motion.changed() {
             let Some(rb) = bodies.get_mut(h) else {
                 continue;
