@@ -41,15 +41,19 @@ impl Integrator {
         let cap = 4 + 2 * (self.rows.len() + self.patches.len());
         let mut slope = std::mem::take(&mut self.probe_slope);
         self.seen_modes.clear();
+        let mut settled = false;
         for _ in 0..cap {
             self.settling += 1;
             self.refresh_constraints();
             let y = std::mem::take(&mut self.y);
             self.eval(&y, &mut slope, false);
             self.y = y;
+            // cleared by a projection of the velocities (`stop_slips`)
+            self.slope_current = true;
             let mut changed = self.settle_points(&slope);
             changed |= self.settle_patches(&slope);
             if !changed {
+                settled = true;
                 break;
             }
             let signature = self.mode_signature();
@@ -60,6 +64,8 @@ impl Integrator {
         }
         self.refresh_constraints();
         self.probe_slope = slope;
+        // the last pass's evaluation holds for the modes it left
+        self.slope_current &= settled;
     }
 
     /// A 64-bit digest (FNV-1a) of every point's and patch's mode and of
@@ -314,6 +320,7 @@ impl Integrator {
     /// keeps every held row's rate at zero), applied to the velocities and
     /// booked on the rows' points.
     fn stop_slips(&mut self) {
+        self.slope_current = false;
         self.refresh_constraints();
         let lay = self.layout;
         let mut y = std::mem::take(&mut self.y);
