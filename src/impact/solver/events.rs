@@ -202,6 +202,7 @@ impl Integrator {
         let mut y = std::mem::take(&mut self.y);
         rk.dense_state(theta, &mut y);
         self.y = y;
+        self.slope_current = false;
         self.clock.x += theta * rk.h;
         self.note_peaks();
         for k in 0..self.due.len() {

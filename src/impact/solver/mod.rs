@@ -207,6 +207,10 @@ pub(crate) struct Integrator {
     tangents: Vec<Axis>,
     probe_state: Vec<f64>,
     probe_slope: Vec<f64>,
+    /// `probe_slope` holds dy/dt at `y` with the present modes: the last
+    /// settling ended on a pass that changed nothing (or `ending_point`
+    /// evaluated there), so the next step's first stage is a copy of it.
+    slope_current: bool,
 }
 
 impl Integrator {

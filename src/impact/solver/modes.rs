@@ -10,7 +10,9 @@
 //!   other forces push it in (δ̈ < 0).
 //! * A held point lets go when its force λ would be negative, or is zero
 //!   (nothing pushes it any more).
-//! * A patch with no loaded point has no friction (idle). A loaded patch
+//! * A patch with no loaded point has no friction (idle); a touching point
+//!   pushed in at once (an e = 0 point whose compression has just ended
+//!   and that is pushed again) counts as loaded. A loaded patch
 //!   without slip sticks while the force that keeps it stuck is within
 //!   μ_s N; otherwise it slides against the push. A sliding patch whose slip
 //!   is zero keeps sliding only if the push accelerates it that way.
@@ -41,15 +43,19 @@ impl Integrator {
         let cap = 4 + 2 * (self.rows.len() + self.patches.len());
         let mut slope = std::mem::take(&mut self.probe_slope);
         self.seen_modes.clear();
+        let mut settled = false;
         for _ in 0..cap {
             self.settling += 1;
             self.refresh_constraints();
             let y = std::mem::take(&mut self.y);
             self.eval(&y, &mut slope, false);
             self.y = y;
+            // cleared by a projection of the velocities (`stop_slips`)
+            self.slope_current = true;
             let mut changed = self.settle_points(&slope);
             changed |= self.settle_patches(&slope);
             if !changed {
+                settled = true;
                 break;
             }
             let signature = self.mode_signature();
@@ -60,6 +66,8 @@ impl Integrator {
         }
         self.refresh_constraints();
         self.probe_slope = slope;
+        // the last pass's evaluation holds for the modes it left
+        self.slope_current &= settled;
     }
 
     /// A 64-bit digest (FNV-1a) of every point's and patch's mode and of
@@ -189,8 +197,8 @@ impl Integrator {
     /// pushed in by the other forces (δ̈ < 0 in `slope`, dy/dt at the
     /// present state): it loads again at once (an e = 0 point whose
     /// compression has just ended and that is pushed again, cycle after
-    /// cycle), so a sliding patch of it need not go idle and come back at a
-    /// switch of its own one rounding later.
+    /// cycle), so its patch need not go idle and come back at a switch of
+    /// its own one rounding later.
     fn pushed_in(&self, i: usize, slope: &[f64]) -> bool {
         let row = &self.rows[i];
         let q = self.y[self.layout.q(i)];
@@ -209,12 +217,15 @@ impl Integrator {
             let members = &self.members[patch.first..patch.first + patch.count];
             let slip = rate(&self.y, patch.a, patch.b, &patch.tangent);
             let now = self.patch_modes[p];
-            // a sliding patch whose points are unloaded but pushed in at
-            // once keeps sliding: its friction −μ s N grows from zero with
-            // the load, the direction of its slip is unchanged
+            // a patch whose points are unloaded but pushed in at once (an
+            // e = 0 point whose compression has just ended) is loaded from
+            // this instant: a sliding patch keeps sliding (its friction
+            // −μ s N grows from zero with the load, the direction of its
+            // slip is unchanged), any other takes its mode here, where it
+            // would otherwise go idle and take it at the point's onset one
+            // rounding of q later (a switch, and a step, for nothing)
             let loaded = members.iter().any(|&i| self.carries_load(i))
-                || (matches!(now, PatchMode::Slide(s) if s * slip > thr)
-                    && members.iter().any(|&i| self.pushed_in(i, slope)));
+                || members.iter().any(|&i| self.pushed_in(i, slope));
             let next = if patch.frictionless() || !loaded {
                 // no load, no friction: a stuck row without load would
                 // carry whatever force the other stuck rows leave it
@@ -314,6 +325,7 @@ impl Integrator {
     /// keeps every held row's rate at zero), applied to the velocities and
     /// booked on the rows' points.
     fn stop_slips(&mut self) {
+        self.slope_current = false;
         self.refresh_constraints();
         let lay = self.layout;
         let mut y = std::mem::take(&mut self.y);

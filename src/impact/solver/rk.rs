@@ -52,7 +52,13 @@ impl Integrator {
         }
         if !rk.fresh {
             let (y0, k) = (&rk.y0, &mut rk.k[0]);
-            self.eval(y0, k, false);
+            if self.slope_current {
+                // y0 is the state the modes were just settled at (or the
+                // end of a segment checked by `ending_point`)
+                k.copy_from_slice(&self.probe_slope);
+            } else {
+                self.eval(y0, k, false);
+            }
             scale(k, self.slope(x0, y0));
             rk.fresh = true;
         }
