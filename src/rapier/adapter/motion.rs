@@ -115,17 +115,14 @@ pub(crate) struct Motion {
     /// Paths are predictions: from the pose now, at the velocity now.
     predicting: bool,
     /// The pose (centre of mass, angle) the pass read for each body at the
-    /// end of a piece, by arena index, with the stamp of that piece
-    /// (`STALE`: none, or an impact moved the body since): the next
-    /// piece's start pose, read once instead of twice (an `atan2` per body
-    /// and piece).
-    ends: Vec<(u64, [f64; 2], f64)>,
+    /// end of a piece, by arena index, with the stamp of that piece (`None`:
+    /// none noted, or an impact moved the body since): the next piece's
+    /// start pose, read once instead of twice (an `atan2` per body and
+    /// piece).
+    ends: Vec<Option<(u64, [f64; 2], f64)>>,
     /// The stamp of the current piece (one more at every `record_start`).
     piece: u64,
 }
-
-/// The stamp of an end pose that cannot be carried.
-const STALE: u64 = u64::MAX;
 
 const NONE: u32 = u32::MAX;
 
@@ -153,14 +150,14 @@ impl Motion {
         }
         self.starts.clear();
         let last = self.piece;
-        self.piece = self.piece.wrapping_add(1) % STALE;
+        self.piece = self.piece.wrapping_add(1);
         for h in islands.active_bodies() {
             let Some(rb) = bodies.get(h) else { continue };
             if !rb.is_dynamic() {
                 continue;
             }
             let (com, angle) = match self.ends.get(index(h)) {
-                Some(&(stamp, com, angle)) if carry && stamp == last => (com, angle),
+                Some(&Some((stamp, com, angle))) if carry && stamp == last => (com, angle),
                 _ => com_and_angle(rb),
             };
             *slot(&mut self.start_of, index(h)) = self.starts.len() as u32;
@@ -173,9 +170,9 @@ impl Motion {
     pub fn note_end(&mut self, h: RigidBodyHandle, com: [f64; 2], angle: f64) {
         let i = index(h);
         if self.ends.len() <= i {
-            self.ends.resize(i + 1, (STALE, [0.0; 2], 0.0));
+            self.ends.resize(i + 1, None);
         }
-        self.ends[i] = (self.piece, com, angle);
+        self.ends[i] = Some((self.piece, com, angle));
     }
 
     /// Forgets the end poses noted for the bodies an impact of this pass
@@ -183,7 +180,7 @@ impl Motion {
     pub fn forget_changed_ends(&mut self) {
         for (h, p) in self.handles.iter().zip(&self.paths) {
             if let (true, Some(end)) = (p.changed, self.ends.get_mut(index(*h))) {
-                end.0 = STALE;
+                *end = None;
             }
         }
     }
