@@ -519,6 +519,21 @@ fn a_scene_is_judged_against_native_from_nearby_starts_and_as_topple_steps_it() 
         ]
     );
 
+    // a frame no longer than topple's sub-step is one piece: e = 0 alone
+    let mut short = c.scene.clone();
+    short.solver.dt = 1.0 / 300.0;
+    let one: Vec<_> = native_as_topple(&short)
+        .iter()
+        .map(|s| {
+            (
+                s.solver.dt,
+                s.solver.iterations,
+                s.materials.iter().all(|m| m.restitution == 0.0),
+            )
+        })
+        .collect();
+    assert_eq!(one, [(1.0 / 300.0, 4, true)]);
+
     let o = run_scene_combo(&c, 60.0);
     let (native, _) = o.native.expect("native ran on the same scene");
     let near = o.nearby.as_ref().expect("deeper than native: run again");
