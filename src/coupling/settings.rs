@@ -88,6 +88,28 @@ impl ToppleSettings {
     /// The default [`ToppleSettings::rest_fraction`].
     pub const DEFAULT_REST_FRACTION: f64 = 0.01;
 
+    /// How many equal sub-steps an engine adapter takes a step of `dt` (s)
+    /// in ([`ToppleSettings::max_substep`]): ⌈dt / max_substep⌉, at most
+    /// 1,000, and 1 without a sub-step or when the step is no longer. The
+    /// quotient is taken with a relative allowance of 10⁻⁶, above the
+    /// rounding of Δt in an f32 build (1/60 s as f32 over 1/240 s is
+    /// 4.0000002), so that 1/60 over 1/240 is 4, not 5, in both builds.
+    ///
+    /// ```
+    /// use topple::coupling::ToppleSettings;
+    /// let s = ToppleSettings::default(); // 1/240 s
+    /// assert_eq!(s.substeps(1.0 / 60.0), 4);
+    /// assert_eq!(s.substeps(f64::from(1.0f32 / 60.0)), 4);
+    /// assert_eq!(s.substeps(1.0 / 100.0), 3);
+    /// assert_eq!(s.substeps(1.0 / 300.0), 1);
+    /// ```
+    pub fn substeps(&self, dt: f64) -> usize {
+        match self.max_substep {
+            Some(h) if h > 0.0 && dt > h => ((dt / h) * (1.0 - 1e-6)).ceil().min(1e3) as usize,
+            _ => 1,
+        }
+    }
+
     /// The resolver's settings for an impact under these settings: `impact`
     /// with its rest speed raised to `rest_fraction · min_approach_speed`.
     ///

@@ -419,15 +419,10 @@ impl ToppleRapier {
     /// ([`ToppleSettings::max_substep`], at most 1,000; native Rapier never
     /// sub-steps).
     fn substeps(&self, dt: f64) -> usize {
-        match self.settings.max_substep {
-            Some(h) if self.hooks.mode == ImpactResponse::Topple && h > 0.0 && dt > h => {
-                // a tolerance above the rounding of Δt in the f32 build
-                // (relative 6·10⁻⁸: 1/60 s as f32, over 1/240 s, is
-                // 4.0000002), so that 1/60 over 1/240 is 4, not 5, in
-                // both builds
-                ((dt / h) * (1.0 - 1e-6)).ceil().min(1e3) as usize
-            }
-            _ => 1,
+        if self.hooks.mode == ImpactResponse::Topple {
+            self.settings.substeps(dt)
+        } else {
+            1
         }
     }
 

@@ -133,12 +133,7 @@ pub fn native_as_topple(scene: &Scene) -> Vec<Scene> {
     }
     let dt = scene.solver.dt;
     let length_unit = scene.solver.length_unit.unwrap_or(1.0);
-    let pieces = crate::rapier::scene::topple_settings(&scene.solver, length_unit)
-        .max_substep
-        .filter(|&h| h > 0.0 && dt > h)
-        // the adapter's count (`ToppleRapier::substeps`), with its allowance
-        // for f32's rounding of Δt
-        .map_or(1, |h| ((dt / h) * (1.0 - 1e-6)).ceil().min(1e3) as usize);
+    let pieces = crate::rapier::scene::topple_settings(&scene.solver, length_unit).substeps(dt);
     let mut out = vec![resting.clone()];
     if pieces > 1 {
         let n = scene.solver.iterations;
