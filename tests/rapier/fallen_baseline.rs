@@ -4,8 +4,17 @@
 //! finer step, which it must not need.
 
 use topple::stress::{
-    draw, run_combo, violations, Kind, NativeRockBack, Observation, StressEngine, SweepSpec,
+    draw, run_combo, violations, Combo, Kind, NativeRockBack, Observation, StressEngine, SweepSpec,
 };
+
+/// Combination `c` at its step over `div`, and its run within the full
+/// sweep's budget.
+fn at_step(c: &Combo, div: f64) -> (Combo, Observation) {
+    let mut fine = c.clone();
+    fine.dt = c.dt / div;
+    let o = run_combo(&fine, 120.0);
+    (fine, o)
+}
 
 /// Combination 896 of the full sweep, seed 1 (Domino X, s/h 0.102, 13
 /// blocks, e1 0.6, e2 0.5, Rapier f64 at Δt = 1/120 s): after the last
@@ -34,9 +43,7 @@ fn combo_896_native_rapier_stands_blocks_up_topple_does_not() {
     );
     assert!(n.fallen_drop > 0, "native Rapier kept its blocks down");
     for div in [1.0, 2.0] {
-        let mut t = c.clone();
-        t.dt = c.dt / div;
-        let o = run_combo(&t, 120.0);
+        let (t, o) = at_step(&c, div);
         println!(
             "topple at Δt/{div}: drop {} (blocks {:?}, {:.2}°), native beside it {:?}",
             o.fallen_drop,
@@ -130,9 +137,7 @@ fn combo_222_rocks_back_as_far_as_native_rapier_and_less_at_finer_steps() {
     assert!(r.native_most.to_degrees() > 10.0);
     let mut last = o.fallen_rock_back;
     for div in [2.0, 4.0] {
-        let mut fine = c.clone();
-        fine.dt = c.dt / div;
-        let f = run_combo(&fine, 120.0);
+        let (_, f) = at_step(&c, div);
         println!(
             "Δt/{div}: drop {}, largest rock-back {:.2}°",
             f.fallen_drop,
