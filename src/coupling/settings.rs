@@ -9,10 +9,8 @@ use super::patch::PatchRule;
 ///
 /// The default resolves impacts with the time-domain resolver
 /// ([`ImpactSettings::adaptive`], docs/model.md §7) at a relative tolerance
-/// of 10⁻⁶: an elastic cradle keeps its energy to 10⁻⁶ in one step, the
-/// domino rows' v̂_na at 1/60 s are within 0.05 % of a run at 10⁻¹⁰ (means
-/// of a hundred nearby starts, docs/impact.md, "Steps per impact, round
-/// nine"), and the rows cost a quarter of what the adaptive impulse
+/// of 2·10⁻⁷: an elastic cradle keeps its energy to 10⁻⁶ in one step, and
+/// the domino rows at 1/60 s cost a quarter of what the adaptive impulse
 /// stepping cost (docs/game-rate.md); set `impact` to
 /// [`ImpactSettings::fixed`] for the paper's scheme.
 ///
@@ -21,12 +19,12 @@ use super::patch::PatchRule;
 /// use topple::impact::ImpactSettings;
 /// let s = ToppleSettings::default();
 /// assert_eq!(s.patch.lambda, 9);
-/// assert_eq!(s.impact, ImpactSettings::adaptive(1e-6));
+/// assert_eq!(s.impact, ImpactSettings::adaptive(2e-7));
 /// ```
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct ToppleSettings {
     /// Settings handed to the LZB resolver (default: the time-domain
-    /// resolver at 10⁻⁶; [`ImpactSettings::adaptive_impulse`] and
+    /// resolver at 2·10⁻⁷; [`ImpactSettings::adaptive_impulse`] and
     /// [`ImpactSettings::fixed`] give the impulse stepping).
     pub impact: ImpactSettings,
     /// Which manifold points are closed and how flat patches are subdivided.
@@ -138,7 +136,7 @@ impl ToppleSettings {
 impl Default for ToppleSettings {
     fn default() -> Self {
         ToppleSettings {
-            impact: ImpactSettings::adaptive(1e-6),
+            impact: ImpactSettings::adaptive(2e-7),
             patch: PatchRule::default(),
             min_approach_speed: 1e-3,
             max_group_hops: Some(Self::DEFAULT_WINDOW),
