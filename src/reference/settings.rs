@@ -67,7 +67,11 @@ pub struct Settings {
     /// count as sticking (default 10⁻³).
     pub velocity_tolerance: f64,
     /// A closed contact approaching faster than this fraction of √(gh) starts
-    /// an impact (default 10⁻⁶, round-off level).
+    /// an impact; a slower one is stopped by the projection onto the active
+    /// contacts, as a separation slower than `velocity_tolerance` is (default
+    /// [`Settings::APPROACH_TOLERANCE`] = 10⁻⁴). The time-domain resolver ends
+    /// an impact at half this speed (its rest speed, docs/model.md §9), so
+    /// this is also where each impact's tail is cut.
     pub approach_tolerance: f64,
     /// A block at the back of the moving window is frozen (taken out of the
     /// integration, its kinetic energy booked as `frozen`) when its speeds
@@ -146,7 +150,7 @@ impl Default for Settings {
             },
             gap_tolerance: 1e-6,
             velocity_tolerance: 1e-3,
-            approach_tolerance: 1e-6,
+            approach_tolerance: Self::APPROACH_TOLERANCE,
             freeze_tolerance: Self::FREEZE_TOLERANCE,
             event_time_tolerance: 1e-10,
             heel_contacts: false,
@@ -171,6 +175,26 @@ fn is_zero(x: &f64) -> bool {
 impl Settings {
     /// The default freeze tolerance (see [`Settings::freeze_tolerance`]).
     pub const FREEZE_TOLERANCE: f64 = 1e-2;
+
+    /// The default approach tolerance (see [`Settings::approach_tolerance`]),
+    /// a fraction of √(gh).
+    ///
+    /// It was 10⁻⁶ (round-off level). The impacts of the Table 1 rows'
+    /// leaning trains then ran until nothing in a group of 30–70 contact
+    /// points approached faster than 5·10⁻⁷ √(gh): hundreds of resolver steps
+    /// each, most of them in the slow tail of the wave running back and
+    /// forth along the train. At 10⁻⁴ the rows of docs/reference-performance.md
+    /// ("Round nine") run 1.1–3 times faster and their v̂_na stays within
+    /// 2·10⁻⁴ (relative) of runs at 10⁻⁷ with the resolver at 10⁻⁸, below the
+    /// 0.1 % the defaults are held to; an approach slower than 10⁻⁴ √(gh)
+    /// is a tenth of the separations the engine already stops
+    /// (`velocity_tolerance`, 10⁻³).
+    ///
+    /// ```
+    /// use topple::reference::Settings;
+    /// assert_eq!(Settings::default().approach_tolerance, Settings::APPROACH_TOLERANCE);
+    /// ```
+    pub const APPROACH_TOLERANCE: f64 = 1e-4;
 
     /// The defaults with the paper's fixed impulse step ΔP = 10⁻⁴ P₀
     /// (Sec. 3.1) in the impacts, named here rather than taken from the

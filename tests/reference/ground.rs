@@ -176,8 +176,11 @@ mod default_freeze_is_within_half_a_percent {
 /// v̂_na of a 30-block ideal Domino T row at spacing `sh`·h on `ground`: the
 /// defaults within 0.5 % of the converged run.
 fn default_freeze_against_converged(ground: Ground, sh: f64) {
+    // every approach down to round-off resolved as an impact (the default
+    // approach tolerance stops those slower than 10⁻⁴ √(gh) by projection)
     let converged = Settings {
         freeze_tolerance: 1e-4,
+        approach_tolerance: 1e-6,
         ..Settings::paper_impacts()
     };
     let mut p = Preset::T.params().ideal();

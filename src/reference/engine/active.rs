@@ -22,11 +22,16 @@ fn closed_between_moving(
     if !g.valid || g.gap > eps {
         return None;
     }
+    moving_kin(view, rc, &g).map(|k| (g, k))
+}
+
+/// The velocity terms of closed contact `g` if both its blocks move (the
+/// ground counts as moving).
+fn moving_kin(view: &View, rc: &RowConst, g: &Geom) -> Option<Kin> {
     if view.local(Some(g.corner)).is_none() || (g.face.is_some() && view.local(g.face).is_none()) {
         return None;
     }
-    let k = rc.kin(view, &g);
-    Some((g, k))
+    Some(rc.kin(view, g))
 }
 
 impl Engine {
@@ -133,10 +138,7 @@ impl Engine {
             let eps = self.eps_gap;
             let vt = self.v_tol;
             let vapp = self.v_app;
-            self.for_each_slot(&view, |i, slot| {
-                let Some((_, k)) = closed_between_moving(rc, &view, i, slot, eps) else {
-                    return;
-                };
+            let mut take = |i: usize, slot: usize, k: Kin| {
                 if k.gdot >= -vapp && k.gdot <= vt {
                     cands.push(Candidate {
                         block: i,
@@ -144,7 +146,24 @@ impl Engine {
                         vt: k.vt,
                     });
                 }
-            });
+            };
+            // the impact stage's list of the closed contacts, when it holds
+            // the present positions and window (the same contacts in the
+            // same order as the scan below)
+            let closed = &self.impact_buffers;
+            if closed.closed_known {
+                for &(i, slot, g) in &closed.closed {
+                    if let Some(k) = moving_kin(&view, rc, &g) {
+                        take(i, slot, k);
+                    }
+                }
+            } else {
+                self.for_each_slot(&view, |i, slot| {
+                    if let Some((_, k)) = closed_between_moving(rc, &view, i, slot, eps) {
+                        take(i, slot, k);
+                    }
+                });
+            }
         }
         {
             let view = View {

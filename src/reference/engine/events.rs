@@ -145,6 +145,7 @@ impl Engine {
     /// Impacts, contact mode, projection; then the derivative for the next step.
     pub(super) fn handle_events(&mut self) -> Result<(), EngineError> {
         self.sync_out();
+        self.impact_buffers.closed_known = false;
         let mut impacted = false;
         for _ in 0..20 {
             if !self.resolve_impacts()? {

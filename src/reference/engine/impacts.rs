@@ -66,21 +66,19 @@ impl Engine {
 
     /// Step 1: the closed contacts approaching faster than the impact
     /// threshold, into `buf.approaching`; the frozen blocks they strike are
-    /// woken (the window grows) until none is left outside it.
+    /// woken (the window grows) until none is left outside it. Every closed
+    /// contact goes into `buf.closed` on the way, for the group (step 2)
+    /// and for the next impact at this instant, which tests only those
+    /// (`closed_known`: the positions and the window have not changed).
     pub(super) fn find_approaching(&mut self, buf: &mut ImpactBuffers) -> Result<(), EngineError> {
-        let mut woke = true;
-        while woke {
-            woke = false;
+        loop {
             buf.approaching.clear();
+            if !buf.closed_known {
+                self.scan_closed(buf);
+            }
             let view = self.view();
             let (mut new_lo, mut new_hi) = (self.lo, self.hi);
-            self.for_each_slot(&view, |i, slot| {
-                let Some(g) = self.rc.geom(&view, i, slot) else {
-                    return;
-                };
-                if !g.valid || g.gap > self.eps_gap {
-                    return;
-                }
+            for &(i, slot, g) in &buf.closed {
                 let k = self.rc.kin(&view, &g);
                 if k.gdot < -self.v_app {
                     buf.approaching.push((i, slot));
@@ -93,21 +91,37 @@ impl Engine {
                         }
                     }
                 }
-            });
-            if (new_lo, new_hi) != (self.lo, self.hi) {
-                self.sync_out();
-                self.lo = new_lo;
-                self.hi = new_hi;
-                self.rebuild_window()?;
-                woke = true;
             }
+            if (new_lo, new_hi) == (self.lo, self.hi) {
+                return Ok(());
+            }
+            self.sync_out();
+            self.lo = new_lo;
+            self.hi = new_hi;
+            self.rebuild_window()?;
+            buf.closed_known = false;
         }
-        Ok(())
+    }
+
+    /// Every closed contact of the window (valid, gap within the gap
+    /// tolerance) with its geometry into `buf.closed`, in slot order.
+    fn scan_closed(&self, buf: &mut ImpactBuffers) {
+        buf.closed.clear();
+        let view = self.view();
+        self.for_each_slot(&view, |i, slot| {
+            if let Some(g) = self.rc.geom(&view, i, slot)
+                && g.valid
+                && g.gap <= self.eps_gap
+            {
+                buf.closed.push((i, slot, g));
+            }
+        });
+        buf.closed_known = true;
     }
 
     /// Step 2: the group, `buf.in_group`: the blocks of the approaching
-    /// contacts and the runs of moving blocks linked to them by closed
-    /// contacts (all closed contacts into `buf.closed`).
+    /// contacts and the runs of moving blocks linked to them by the closed
+    /// contacts of step 1.
     pub(super) fn mark_group(&self, buf: &mut ImpactBuffers) {
         let lambda = self.rc.p.lambda_points;
         let nb = self.hi - self.lo;
@@ -115,25 +129,18 @@ impl Engine {
         buf.linked.clear();
         buf.linked.resize(nb, false);
         buf.far_links.clear();
-        buf.closed.clear();
-        self.for_each_slot(&view, |i, slot| {
-            let Some(g) = self.rc.geom(&view, i, slot) else {
-                return;
+        for &(i, slot, _) in &buf.closed {
+            let Some(j) = partner(i, slot, lambda) else {
+                continue;
             };
-            if g.valid && g.gap <= self.eps_gap {
-                buf.closed.push((i, slot));
-                let Some(j) = partner(i, slot, lambda) else {
-                    return;
-                };
-                if i >= self.lo && j < self.hi {
-                    if j == i + 1 {
-                        buf.linked[i - self.lo] = true;
-                    } else {
-                        buf.far_links.push((i - self.lo, j - self.lo));
-                    }
+            if i >= self.lo && j < self.hi {
+                if j == i + 1 {
+                    buf.linked[i - self.lo] = true;
+                } else {
+                    buf.far_links.push((i - self.lo, j - self.lo));
                 }
             }
-        });
+        }
         buf.in_group.clear();
         buf.in_group.resize(nb, false);
         for &(i, slot) in &buf.approaching {
@@ -197,7 +204,6 @@ impl Engine {
                 buf.members.push(i);
             }
         }
-        let view = self.view();
         let (lo, hi) = (self.lo, self.hi);
         let (in_group, index) = (&buf.in_group, &buf.index);
         let to_body = |j: Option<usize>| -> Option<usize> {
@@ -209,8 +215,7 @@ impl Engine {
             }
         };
         buf.contacts.clear();
-        for &(i, slot) in &buf.closed {
-            let g = self.rc.geom(&view, i, slot).expect("slot exists");
+        for &(_, slot, g) in &buf.closed {
             let a = to_body(Some(g.corner));
             let f = to_body(g.face);
             if a.is_none() && f.is_none() {

@@ -26,7 +26,7 @@ use std::cell::RefCell;
 use std::time::Instant;
 
 use super::dynamics::{Active, Dynamics, Mode, RowConst};
-use super::geometry::slots_per_block;
+use super::geometry::{slots_per_block, Geom};
 use super::modes::{Candidate, ModeTol};
 use super::settings::Settings;
 use super::snapshot::Snapshot;
@@ -94,8 +94,15 @@ pub struct RunResult {
 struct ImpactBuffers {
     /// Closed contacts approaching faster than the approach tolerance.
     approaching: Vec<(usize, usize)>,
-    /// Every closed contact (block, slot) of the window.
-    closed: Vec<(usize, usize)>,
+    /// Every closed contact of the window: (block, slot) and its geometry,
+    /// in the order of `for_each_slot`.
+    closed: Vec<(usize, usize, Geom)>,
+    /// `closed` holds the closed contacts at the present positions and
+    /// window: an impact changes velocities only, so the scans after it
+    /// (the next impact's search, its group) need not measure every slot
+    /// again. Cleared by `handle_events` (the positions have moved since)
+    /// and when the window grows.
+    closed_known: bool,
     /// Window block b linked to b + 1 by a closed contact.
     linked: Vec<bool>,
     /// Window blocks (a, b), not neighbours, linked by a closed contact.
