@@ -133,6 +133,7 @@ impl PlasticSolver {
     }
 
     /// The largest approach speed of a contact (m/s; 0 if none approaches).
+    #[cfg(test)]
     fn worst_approach(&self) -> f64 {
         self.rows
             .iter()
