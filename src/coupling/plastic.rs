@@ -17,7 +17,8 @@
 //! set to μ P_n after a sticking value up to μ_s P_n) can. The solve checks
 //! the energy at its end and, should it have risen, solves the impact
 //! again without friction, so the result never has more kinetic energy
-//! than the bodies brought in (the property the tests check). Sweeps stop when no impulse changes by more than
+//! than the bodies brought in (the property the tests check). Sweeps stop
+//! when no impulse changes by more than
 //! [`PlasticSolver::TOLERANCE`] of the group's impulse scale, or after
 //! [`PlasticSolver::MAX_SWEEPS`]; the result then leaves approach speeds below
 //! that tolerance times the velocity scale.
@@ -81,8 +82,7 @@ impl PlasticSolver {
 
     /// Resolves the impact of `bodies` at `contacts` as plastic into `out`
     /// (velocities, impulses, kinetic energy before and after; `steps` counts
-    /// the sweeps).
-    /// Inputs are assumed valid (see [`crate::impact`]).
+    /// the sweeps). Inputs are assumed valid (see [`crate::impact`]).
     pub fn solve_into(&mut self, bodies: &[Body], contacts: &[Contact], out: &mut ImpactOutcome) {
         self.load(bodies, contacts);
         let before = self.kinetic_energy();
