@@ -103,14 +103,11 @@ pub struct GroupSolver {
     work: u64,
 }
 
-/// Kinetic energy after the impact exceeds the energy before by more than
-/// rounding (10⁻⁹ relative): the LZB law never creates energy (e ≤ 1,
-/// friction dissipates), so such a result is a failed integration (an
-/// adaptive step far too coarse) and goes to the next stage.
-/// An outcome with more kinetic energy than before, beyond round-off
-/// (10⁻⁹ relative): never accepted from the LZB law.
+/// [`ImpactOutcome::gains_energy`]: an LZB result that creates energy is a
+/// failed integration (an adaptive step far too coarse) and goes to the
+/// next stage.
 pub fn gains_energy(out: &ImpactOutcome) -> bool {
-    out.kinetic_energy_after > out.kinetic_energy_before * (1.0 + 1e-9) + f64::MIN_POSITIVE
+    out.gains_energy()
 }
 
 /// Settling evaluations of the time-domain resolver that cost one of its

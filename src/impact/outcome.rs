@@ -60,6 +60,24 @@ pub struct ImpactOutcome {
 }
 
 impl ImpactOutcome {
+    /// Kinetic energy after the impact exceeds the energy before by more
+    /// than rounding (10⁻⁹ relative). No stage of topple's impacts may
+    /// create energy (the LZB law has e ≤ 1 and friction dissipates; the
+    /// plastic solve re-solves without friction rather than return one).
+    ///
+    /// ```
+    /// use topple::impact::ImpactOutcome;
+    /// let mut out = ImpactOutcome::default();
+    /// out.kinetic_energy_before = 1.0;
+    /// out.kinetic_energy_after = 1.0 + 1e-12;
+    /// assert!(!out.gains_energy());
+    /// out.kinetic_energy_after = 1.01;
+    /// assert!(out.gains_energy());
+    /// ```
+    pub fn gains_energy(&self) -> bool {
+        self.kinetic_energy_after > self.kinetic_energy_before * (1.0 + 1e-9) + f64::MIN_POSITIVE
+    }
+
     /// Sets `kinetic_energy_after` from the velocities after: ½ m v² + ½ I ω²
     /// of the free bodies (J), `bodies` giving their masses in the same order.
     pub(crate) fn set_kinetic_energy_after(&mut self, bodies: &[Body]) {
