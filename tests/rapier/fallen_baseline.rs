@@ -3,8 +3,11 @@
 //! (it runs up to the last hit only), and against topple's own run at a
 //! finer step, which it must not need.
 
+use topple::reference::{self, Integrator, Settings};
+use topple::stress::scene::NEARBY_RUNS;
 use topple::stress::{
-    draw, run_combo, violations, Combo, Kind, NativeRockBack, Observation, StressEngine, SweepSpec,
+    draw, run_combo, violations, Combo, Kind, NativeRockBack, Observation, RowWatch, StressEngine,
+    SweepSpec, ROW_NEARBY_PUSH,
 };
 
 /// Combination `c` at its step over `div`, and its run within the full
@@ -111,11 +114,17 @@ fn a_drop_native_rapier_does_not_match_is_counted() {
 /// the last block slides out flat ahead of the row, and the blocks behind
 /// it rock back by about 20° in every Rapier engine at this step; in
 /// topple's f32 build blocks 17 and 18 end below π/4 (docs/stress.md, "A
-/// fallen count native Rapier rocks back as far"). The paper's model run
-/// past the last hit settles back by 0.6°, so the rock-back is the coarse
-/// step's: topple's must shrink with the step, and at Δt native Rapier
-/// must rock a fallen block back about as far from nearby starts, which is
-/// what the rule holds the drop against.
+/// fallen count native Rapier rocks back as far"). The paper's model, run
+/// past the last hit by the reference engine ([`model_rock_back`]), settles
+/// the train back by well under a degree, so the rest is the coarse step's
+/// error: Rapier's step is first order, so topple's rock-back in excess of
+/// the model's must halve with each halving of the step. A rock-back of
+/// 18° that ends on one side of π/4 or the other, or one of 4° that jumps
+/// to 14°, turns on the bits of the run (docs/impact.md, "Steps per impact,
+/// round ten"), so the excess is judged as the median over the drawn start
+/// and the rule's [`NEARBY_RUNS`] nearby starts. At Δt native Rapier must
+/// rock a fallen block back about as far from nearby starts, which is what
+/// the rule holds the drop against.
 #[test]
 fn combo_222_rocks_back_as_far_as_native_rapier_and_less_at_finer_steps() {
     let spec = SweepSpec::full(1);
@@ -133,18 +142,72 @@ fn combo_222_rocks_back_as_far_as_native_rapier_and_less_at_finer_steps() {
         r.native_drop
     );
     assert!(violations(&c, &o).is_empty());
-    // a rock-back of Rapier's at 1/60 s: far beyond the model's 0.6°
+    // a rock-back of Rapier's at 1/60 s: far beyond the model's
     assert!(r.native_most.to_degrees() > 10.0);
-    let mut last = o.fallen_rock_back;
-    for div in [2.0, 4.0] {
-        let (_, f) = at_step(&c, div);
+    let model = model_rock_back(&c);
+    println!("the model's settle-back: {:.3}°", model.to_degrees());
+    let mut last = f64::INFINITY;
+    for div in [1.0, 2.0, 4.0] {
+        let mut excess = Vec::new();
+        for k in 0..=NEARBY_RUNS {
+            let mut near = c.clone();
+            near.row.push = c.row.push + k as f64 * ROW_NEARBY_PUSH;
+            let (_, f) = at_step(&near, div);
+            assert!(f.error.is_none() && !f.over_budget, "Δt/{div}, start {k}");
+            if div > 1.0 {
+                assert_eq!(f.fallen_drop, 0, "Δt/{div}, start {k}");
+            }
+            excess.push(f.fallen_rock_back - model);
+        }
+        let median = median(&mut excess);
         println!(
-            "Δt/{div}: drop {}, largest rock-back {:.2}°",
-            f.fallen_drop,
-            f.fallen_rock_back.to_degrees()
+            "Δt/{div}: rock-back in excess of the model's {:.2}° (median; starts {:.2?})",
+            median.to_degrees(),
+            excess.iter().map(|e| e.to_degrees()).collect::<Vec<_>>()
         );
-        assert_eq!(f.fallen_drop, 0, "Δt/{div}");
-        assert!(f.fallen_rock_back < 0.5 * last, "Δt/{div}");
-        last = f.fallen_rock_back;
+        assert!(median > 0.0 && median < 0.5 * last, "Δt/{div}");
+        last = median;
     }
+}
+
+/// How far the paper's model settles a fallen block of `c`'s row back
+/// (rad, [`Observation::fallen_rock_back`]): the reference engine (heel
+/// contacts, the paper's improved Euler at 10⁻³ s, a tenth of the
+/// paper's step count per second of 10⁻⁴ s; at 2·10⁻³ s, 5·10⁻⁴ s and
+/// Dormand–Prince at 10⁻⁶ the same row reads 0.643°, 0.636°, 0.670°
+/// against 0.661°) run on for 1 s past the last hit, when the train has
+/// settled (it stops once every block is at rest), observed every 2 ms as
+/// the sweep observes it. The sweep's own reference run stops at the last
+/// hit, before the settle-back, and steps at the combination's Δt.
+fn model_rock_back(c: &Combo) -> f64 {
+    let t_end = 2.0 + 4.0 * c.row.n as f64 * c.row.params.time_scale() + 1.0;
+    let settings = Settings {
+        integrator: Integrator::Paper { dt: 1e-3 },
+        heel_contacts: true,
+        stop_at_last_hit: true,
+        after_last_hit: 1.0,
+        t_max: Some(t_end),
+        snapshot_times: (1..)
+            .map(|k| k as f64 * 2e-3)
+            .take_while(|t| *t < t_end)
+            .collect(),
+        ..Settings::default()
+    };
+    let out = reference::run(&c.row, &settings).expect("the reference engine runs the row");
+    assert!(!out.report.stopped_early);
+    assert_eq!(out.report.hit_times.len(), c.row.n, "every block struck");
+    let b = c.row.params.block;
+    let mut watch = RowWatch::new(b.height, b.thickness);
+    for s in &out.snapshots {
+        watch.look(s.time, &s.blocks);
+    }
+    assert_eq!(watch.seen.fallen, c.row.n, "every block fallen");
+    assert_eq!(watch.seen.fallen_drop, 0);
+    watch.seen.fallen_rock_back
+}
+
+/// The median of `v` (sorted in place; the upper one of an even count).
+fn median(v: &mut [f64]) -> f64 {
+    v.sort_by(f64::total_cmp);
+    v[v.len() / 2]
 }
