@@ -146,7 +146,7 @@ fn process_cpu_ms() -> f64 {
 /// The value of `--NAME=VALUE` on the command line, if given. Flags:
 /// `--budget=WORK` (the step work budget instead of topple's default),
 /// `--tolerance=TOL` (the time-domain resolver at this tolerance instead of
-/// the default 2·10⁻⁷), `--impulse=TOL` (the adaptive impulse stepping, the
+/// the default 10⁻⁶), `--impulse=TOL` (the adaptive impulse stepping, the
 /// default before the time-domain resolver).
 fn flag<T: std::str::FromStr>(name: &str) -> Option<T> {
     let prefix = format!("--{name}=");

@@ -238,7 +238,20 @@ fn settings() -> Vec<(&'static str, ImpactSettings)> {
     };
     // the plugins' impact settings, which the label below names
     let plugin_default = topple::coupling::ToppleSettings::default().impact;
-    assert_eq!(plugin_default, ImpactSettings::adaptive(2e-7));
+    assert_eq!(plugin_default, ImpactSettings::adaptive(1e-6));
+    // the plugins' rest speed at 1/60 s under 9.81 m/s²: a fraction of the
+    // impact threshold 2|g|Δt (docs/model.md §9)
+    let rest = |fraction: f64, s: ImpactSettings| {
+        limited(ImpactSettings {
+            rest_speed: fraction * THRESHOLD_1_60,
+            ..s
+        })
+    };
+    let plugin = topple::coupling::ToppleSettings::DEFAULT_REST_FRACTION;
+    assert_eq!(
+        plugin, 0.01,
+        "the labels below name the plugins' rest fraction"
+    );
     vec![
         (
             "paper: fixed ΔP = 10⁻⁴ P₀",
@@ -253,45 +266,39 @@ fn settings() -> Vec<(&'static str, ImpactSettings)> {
             "in time 2·10⁻⁶ (default)",
             limited(ImpactSettings::default()),
         ),
-        // the plugins' rest speed at 1/60 s under 9.81 m/s²: 0.01 of the
-        // impact threshold 2|g|Δt (docs/model.md §9)
         (
             "adaptive impulse 10⁻⁴, rest speed 3.3·10⁻³ m/s (plugin default before)",
-            limited(ImpactSettings {
-                rest_speed: PLUGIN_REST_SPEED,
-                ..ImpactSettings::adaptive_impulse(1e-4)
-            }),
+            rest(plugin, ImpactSettings::adaptive_impulse(1e-4)),
         ),
         (
             "in time 2·10⁻⁶, rest speed 3.3·10⁻³ m/s",
-            limited(ImpactSettings {
-                rest_speed: PLUGIN_REST_SPEED,
-                ..ImpactSettings::default()
-            }),
+            rest(plugin, ImpactSettings::default()),
         ),
-        // a looser tolerance for the plugins, measured against their
-        // default (docs/impact.md, "Steps per impact, a further round")
+        // the plugins' tolerance before, measured against the present one
+        // (docs/impact.md, "Steps per impact, round ten")
         (
-            "in time 10⁻⁶, rest speed 3.3·10⁻³ m/s",
-            limited(ImpactSettings {
-                rest_speed: PLUGIN_REST_SPEED,
-                ..ImpactSettings::adaptive(1e-6)
-            }),
+            "in time 2·10⁻⁷, rest speed 3.3·10⁻³ m/s (plugin default before)",
+            rest(plugin, ImpactSettings::adaptive(2e-7)),
         ),
         (
-            "in time 2·10⁻⁷, rest speed 3.3·10⁻³ m/s (plugin default)",
-            limited(ImpactSettings {
-                rest_speed: PLUGIN_REST_SPEED,
-                ..plugin_default
-            }),
+            "in time 10⁻⁶, rest speed 3.3·10⁻³ m/s (plugin default)",
+            rest(plugin, plugin_default),
+        ),
+        // larger rest fractions (docs/impact.md, "Steps per impact, round ten")
+        (
+            "in time 10⁻⁶, rest speed 9.8·10⁻³ m/s (0.03 of the threshold)",
+            rest(0.03, plugin_default),
+        ),
+        (
+            "in time 10⁻⁶, rest speed 3.3·10⁻² m/s (0.1 of the threshold)",
+            rest(0.1, plugin_default),
         ),
     ]
 }
 
-/// The rest speed the plugins give the resolver at 1/60 s under 9.81 m/s²
-/// (m/s): `ToppleSettings::DEFAULT_REST_FRACTION` · 2|g|Δt.
-const PLUGIN_REST_SPEED: f64 =
-    topple::coupling::ToppleSettings::DEFAULT_REST_FRACTION * 2.0 * 9.81 / 60.0;
+/// The impact threshold of the plugins at 1/60 s under 9.81 m/s² (m/s):
+/// 2|g|Δt, the approach a resting contact picks up in one step.
+const THRESHOLD_1_60: f64 = 2.0 * 9.81 / 60.0;
 
 /// What one step control does on a class.
 struct Measured {

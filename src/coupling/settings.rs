@@ -9,9 +9,11 @@ use super::patch::PatchRule;
 ///
 /// The default resolves impacts with the time-domain resolver
 /// ([`ImpactSettings::adaptive`], docs/model.md §7) at a relative tolerance
-/// of 2·10⁻⁷: an elastic cradle keeps its energy to 10⁻⁶ in one step, and
-/// the domino rows at 1/60 s cost a quarter of what the adaptive impulse
-/// stepping cost (docs/game-rate.md); set `impact` to
+/// of 10⁻⁶: the domino rows of docs/game-rate.md at 1/60 s read their wave
+/// speed within 0.05 % of a run at 10⁻¹⁰ (means over nearby starts), an
+/// elastic cradle keeps its energy to 10⁻⁶ in one step, and impacts take
+/// up to a quarter fewer steps than at 2·10⁻⁷, the default before
+/// (docs/impact.md, "Steps per impact, round ten"); set `impact` to
 /// [`ImpactSettings::fixed`] for the paper's scheme.
 ///
 /// ```
@@ -19,12 +21,12 @@ use super::patch::PatchRule;
 /// use topple::impact::ImpactSettings;
 /// let s = ToppleSettings::default();
 /// assert_eq!(s.patch.lambda, 9);
-/// assert_eq!(s.impact, ImpactSettings::adaptive(2e-7));
+/// assert_eq!(s.impact, ImpactSettings::adaptive(1e-6));
 /// ```
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct ToppleSettings {
     /// Settings handed to the LZB resolver (default: the time-domain
-    /// resolver at 2·10⁻⁷; [`ImpactSettings::adaptive_impulse`] and
+    /// resolver at 10⁻⁶; [`ImpactSettings::adaptive_impulse`] and
     /// [`ImpactSettings::fixed`] give the impulse stepping).
     pub impact: ImpactSettings,
     /// Which manifold points are closed and how flat patches are subdivided.
@@ -136,7 +138,7 @@ impl ToppleSettings {
 impl Default for ToppleSettings {
     fn default() -> Self {
         ToppleSettings {
-            impact: ImpactSettings::adaptive(2e-7),
+            impact: ImpactSettings::adaptive(1e-6),
             patch: PatchRule::default(),
             min_approach_speed: 1e-3,
             max_group_hops: Some(Self::DEFAULT_WINDOW),

@@ -79,7 +79,7 @@ pub struct SolverSpec {
     pub impulse_step: Option<f64>,
     /// The time-domain resolver at this relative tolerance; when neither
     /// this nor `impulse_step` is set, the default of
-    /// [`crate::coupling::ToppleSettings`] (this resolver at 2·10⁻⁷).
+    /// [`crate::coupling::ToppleSettings`] (this resolver at 10⁻⁶).
     pub tolerance: Option<f64>,
     /// λ points across a flat contact patch.
     pub lambda: usize,
