@@ -15,7 +15,8 @@
 //! (Stewart & Trinkle 1996) that is not expected, but the caller checks
 //! the answer all the same.
 //!
-//! Dense tableau, Gauss–Jordan pivots: each pivot costs n (2n + 2)
+//! Dense tableau, Gauss–Jordan pivots: each pivot updates the n + 1
+//! columns that are not basic and the right-hand side, n (n + 2)
 //! multiply–adds. Reused buffers, no allocation once they are grown.
 
 /// Why an LCP was not solved.
@@ -40,18 +41,29 @@ pub(crate) struct Lemke {
     ties: Vec<usize>,
     /// The residual of the refinement.
     residual: Vec<f64>,
+    /// The non-basic variables (their columns are the ones a pivot updates;
+    /// the entering one among them).
+    nonbasic: Vec<usize>,
 }
 
 impl Lemke {
     /// Solves the LCP of `m` (row-major, n × n) and `q` into `z` (length
     /// n); returns the pivots taken. A pivot element must exceed
     /// `1e-10` of the largest |M_ij| (and of 1) in magnitude.
-    pub(crate) fn solve(&mut self, m: &[f64], q: &[f64], z: &mut [f64]) -> Result<usize, LcpFailure> {
+    pub(crate) fn solve(
+        &mut self,
+        m: &[f64],
+        q: &[f64],
+        z: &mut [f64],
+    ) -> Result<usize, LcpFailure> {
         let n = q.len();
         debug_assert_eq!(m.len(), n * n);
         debug_assert_eq!(z.len(), n);
         z.fill(0.0);
-        let Some(start) = (0..n).filter(|&i| q[i] < 0.0).min_by(|&i, &j| q[i].total_cmp(&q[j])) else {
+        let Some(start) = (0..n)
+            .filter(|&i| q[i] < 0.0)
+            .min_by(|&i, &j| q[i].total_cmp(&q[j]))
+        else {
             return Ok(0); // q ≥ 0: z = 0 is the answer
         };
         self.load(m, q);
@@ -90,7 +102,11 @@ impl Lemke {
                 self.read(m, q, z);
                 return Ok(pivots + 1);
             }
-            entering = if leaving < n { leaving + n } else { leaving - n };
+            entering = if leaving < n {
+                leaving + n
+            } else {
+                leaving - n
+            };
         }
         Err(LcpFailure::Pivots)
     }
@@ -104,6 +120,8 @@ impl Lemke {
         self.tableau.resize(n * width, 0.0);
         self.basis.clear();
         self.basis.extend(0..n);
+        self.nonbasic.clear();
+        self.nonbasic.extend(n..=2 * n);
         for i in 0..n {
             let row = &mut self.tableau[i * width..(i + 1) * width];
             row[i] = 1.0;
@@ -135,15 +153,23 @@ impl Lemke {
             }
         }
         let tie = |r: f64, least: f64| r <= least + 1e-12 * least.abs().max(1.0);
-        self.ties
-            .retain(|&i| tie(self.tableau[i * width + width - 1] / self.tableau[i * width + col], least));
+        self.ties.retain(|&i| {
+            tie(
+                self.tableau[i * width + width - 1] / self.tableau[i * width + col],
+                least,
+            )
+        });
         if let Some(&i) = self.ties.iter().find(|&&i| self.basis[i] == 2 * n) {
             return Some(i);
         }
         let mut k = 0;
         while self.ties.len() > 1 && k < n {
             let ratio = |i: usize| self.tableau[i * width + k] / self.tableau[i * width + col];
-            let least = self.ties.iter().map(|&i| ratio(i)).fold(f64::INFINITY, f64::min);
+            let least = self
+                .ties
+                .iter()
+                .map(|&i| ratio(i))
+                .fold(f64::INFINITY, f64::min);
             self.ties.retain(|&i| tie(ratio(i), least));
             k += 1;
         }
@@ -151,24 +177,40 @@ impl Lemke {
     }
 
     /// Gauss–Jordan pivot on (`row`, `col`): the variable of `col` becomes
-    /// basic in `row`.
+    /// basic in `row`. Only the non-basic columns and the right-hand side
+    /// are updated (a basic variable's column is a unit vector and stays
+    /// one); the leaving variable's column is written from the pivot
+    /// column. About n (n + 2) multiply–adds instead of n (2n + 2).
     fn pivot(&mut self, row: usize, col: usize) {
         let width = 2 * self.n + 2;
+        let leaving = self.basis[row];
         let (before, rest) = self.tableau.split_at_mut(row * width);
         let (pivot_row, after) = rest.split_at_mut(width);
         let inv = 1.0 / pivot_row[col];
-        pivot_row.iter_mut().for_each(|x| *x *= inv);
+        for &c in &self.nonbasic {
+            pivot_row[c] *= inv;
+        }
+        pivot_row[width - 1] *= inv;
+        pivot_row[leaving] = inv;
         pivot_row[col] = 1.0;
-        for other in before.chunks_exact_mut(width).chain(after.chunks_exact_mut(width)) {
+        for other in before
+            .chunks_exact_mut(width)
+            .chain(after.chunks_exact_mut(width))
+        {
             let f = other[col];
             if f != 0.0 {
-                for (x, &p) in other.iter_mut().zip(pivot_row.iter()) {
-                    *x -= f * p;
+                for &c in &self.nonbasic {
+                    other[c] -= f * pivot_row[c];
                 }
+                other[width - 1] -= f * pivot_row[width - 1];
+                other[leaving] = -f * inv;
                 other[col] = 0.0;
             }
         }
         self.basis[row] = col;
+        if let Some(slot) = self.nonbasic.iter_mut().find(|c| **c == col) {
+            *slot = leaving;
+        }
     }
 
     /// The value of the variable basic in `row`.
@@ -245,7 +287,9 @@ mod tests {
     #[test]
     fn a_non_negative_q_is_solved_by_zero() {
         let mut z = [7.0; 2];
-        let pivots = Lemke::default().solve(&[1.0, 0.0, 0.0, 1.0], &[0.0, 2.0], &mut z).unwrap();
+        let pivots = Lemke::default()
+            .solve(&[1.0, 0.0, 0.0, 1.0], &[0.0, 2.0], &mut z)
+            .unwrap();
         assert_eq!((pivots, z), (0, [0.0; 2]));
     }
 
@@ -287,7 +331,9 @@ mod tests {
                 .map(|i| w_star[i] - (0..n).map(|j| m[i * n + j] * z_star[j]).sum::<f64>())
                 .collect();
             let mut z = vec![0.0; n];
-            solver.solve(&m, &q, &mut z).unwrap_or_else(|e| panic!("trial {trial}: {e:?}"));
+            solver
+                .solve(&m, &q, &mut z)
+                .unwrap_or_else(|e| panic!("trial {trial}: {e:?}"));
             complementary(&m, &q, &z, 1e-9);
         }
     }

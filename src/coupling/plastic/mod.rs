@@ -8,26 +8,39 @@
 //! sticking, |P_t| = μ P_n when it slides). The velocity change is
 //! Δv = M⁻¹ Jᵀ P (planar bodies, [vx, vy, ω]).
 //!
-//! Solved by projected Gauss–Seidel: each sweep visits the contacts in order,
-//! sets each normal impulse to the value that zeroes its own approach
-//! (clamped at 0), then its tangential impulse to the value that stops its own
-//! slip (clamped to the cone). A normal update, and a tangential one that
-//! sticks or slides at μ_s = μ, minimises the kinetic energy over its own
-//! impulse, so it cannot raise the energy; a slip where μ_s > μ (the impulse
-//! set to μ P_n after a sticking value up to μ_s P_n) can. The solve checks
-//! the energy at its end and, should it have risen, solves the impact
-//! again without friction, so the result never has more kinetic energy
-//! than the bodies brought in (the property the tests check). Sweeps stop
-//! when no impulse changes by more than
-//! [`PlasticSolver::TOLERANCE`] of the group's impulse scale, or after
-//! [`PlasticSolver::MAX_SWEEPS`]; the result then leaves approach speeds below
-//! that tolerance times the velocity scale.
+//! The solve has two stages, one file each:
 //!
-//! Open: where a heavy body lies on a light one, a sweep passes only about
-//! m/M of the heavy body's approach through the light one, and the sweeps
-//! stop at their cap with the stack still sinking (docs/bevy.md, "The
-//! plastic solve": a direct stage for the loaded contacts was measured and
-//! not shipped; the two tests that show it are ignored).
+//! | stage | file | what |
+//! | --- | --- | --- |
+//! | sweeps | `mod.rs` | projected Gauss–Seidel, one contact at a time |
+//! | direct | `direct.rs`, `lemke.rs` | the whole impact as one linear complementarity problem, Lemke's method |
+//!
+//! Each sweep visits the contacts in order, sets each normal impulse to the
+//! value that zeroes its own approach (clamped at 0), then its tangential
+//! impulse to the value that stops its own slip (clamped to the cone). A
+//! normal update, and a tangential one that sticks or slides at μ_s = μ,
+//! minimises the kinetic energy over its own impulse, so it cannot raise
+//! the energy; a slip where μ_s > μ (the impulse set to μ P_n after a
+//! sticking value up to μ_s P_n) can. Sweeps stop when no impulse changes
+//! by more than [`PlasticSolver::TOLERANCE`] of the group's impulse scale.
+//!
+//! Where a heavy body lies on a light one a sweep passes only about m/M of
+//! the heavy body's approach through the light one, and where friction
+//! switches between sticking and slipping the sweeps can cycle: such
+//! solves do not converge in any number of sweeps worth taking. A solve
+//! still unconverged after [`PlasticSolver::DIRECT_AFTER`] sweeps is handed
+//! to the direct stage (direct.rs), which solves the impact exactly (to
+//! rounding) in a number of pivots about half its unknowns, and keeps its
+//! answer if no contact then approaches and the energy has not risen.
+//! Impacts with more than [`PlasticSolver::DIRECT_MAX_UNKNOWNS`] unknowns
+//! (about 40 contact points with friction), a no-slip contact, or a direct
+//! answer that fails its checks go on sweeping up to
+//! [`PlasticSolver::MAX_SWEEPS`].
+//!
+//! The solve checks the energy at its end and, should it have risen (the
+//! stick–slip rule of the sweeps), solves the impact again without
+//! friction, so the result never has more kinetic energy than the bodies
+//! brought in (the property the tests check).
 
 mod direct;
 mod lemke;
@@ -364,10 +377,10 @@ mod tests {
     /// loaded, the closed form is: every body stops, and the normal
     /// impulses through each face sum to the momentum of the bodies above
     /// it. Gauss–Seidel alone drains the heavy box's approach through the
-    /// light ones at about m/M per sweep and stops at the sweep cap with
-    /// the stack still sinking (the heavy box at 0.08 m/s of its 1 m/s).
+    /// light ones at about m/M per sweep and stopped at the sweep cap with
+    /// the stack still sinking (the heavy box at 0.08 m/s of its 1 m/s);
+    /// the direct stage ends it.
     #[test]
-    #[ignore = "open: the sweeps stop at their cap with the stack still sinking (docs/bevy.md, \"The plastic solve\")"]
     fn a_heavy_box_on_light_ones_stops_dead() {
         let (w, h) = (0.2, 0.1);
         let masses = [0.05, 0.025, 10.0];
@@ -421,7 +434,7 @@ mod tests {
     /// A stack of 2–5 boxes of random masses (ratios up to 10⁴), sizes,
     /// offsets and velocities landing on the ground, three points per face;
     /// friction μ up to 0.5 with μ_s from μ to 2μ, or none.
-    pub(super) fn random_stack(draw: &mut impl FnMut() -> f64, friction: bool) -> (Vec<Body>, Vec<Contact>) {
+    fn random_stack(draw: &mut impl FnMut() -> f64, friction: bool) -> (Vec<Body>, Vec<Contact>) {
         let n = 2 + (draw() * 4.0) as usize;
         let (mut bodies, mut contacts, mut y) = (Vec::new(), Vec::new(), 0.0);
         for i in 0..n {
@@ -454,7 +467,7 @@ mod tests {
         (bodies, contacts)
     }
 
-    pub(super) fn xorshift() -> impl FnMut() -> f64 {
+    fn xorshift() -> impl FnMut() -> f64 {
         let mut seed = 0x2545_f491_4f6c_dd1d_u64;
         move || {
             seed ^= seed << 13;
@@ -468,10 +481,9 @@ mod tests {
     /// impact is the projection of the velocities onto the cone of
     /// non-approaching ones in the energy metric; every solve converges,
     /// ends with no contact approaching (10⁻⁹ of the impact speed) and
-    /// without energy gained. Gauss–Seidel alone leaves most of these
+    /// without energy gained. Gauss–Seidel alone left most of these
     /// stacks still sinking after its 1,000 sweeps.
     #[test]
-    #[ignore = "open: the sweeps stop at their cap with stacks still sinking (docs/bevy.md, \"The plastic solve\")"]
     fn frictionless_random_stacks_end_without_approach() {
         let (mut draw, mut solver) = (xorshift(), PlasticSolver::default());
         let mut out = ImpactOutcome::default();
@@ -492,12 +504,14 @@ mod tests {
         }
     }
 
-    /// Random stacks with friction (μ_s ≥ μ): the solve never raises the
-    /// kinetic energy (the bound every stage keeps, by the guard where the
-    /// stick–slip rule does not), and where it converges no contact
-    /// approaches and no friction leaves its cone.
+    /// Random stacks with friction (μ_s from μ to 2μ, mass ratios up to
+    /// 10⁴): the solve never raises the kinetic energy (the bound every
+    /// stage keeps, by the guard where the stick–slip rule does not), ends
+    /// with no contact approaching (10⁻⁸ of the impact speed) and no
+    /// friction outside its cone. The sweeps alone left 593 of these 1,000
+    /// approaching faster than 10⁻³ of it.
     #[test]
-    fn random_stacks_with_friction_never_gain_energy() {
+    fn random_stacks_with_friction_end_without_approach_or_energy_gain() {
         let (mut draw, mut solver) = (xorshift(), PlasticSolver::default());
         let mut out = ImpactOutcome::default();
         for _ in 0..1000 {
@@ -509,16 +523,13 @@ mod tests {
                 out.kinetic_energy_before,
                 out.kinetic_energy_after
             );
-            if out.steps >= PlasticSolver::MAX_SWEEPS {
-                continue;
-            }
             let speed = bodies
                 .iter()
                 .map(|b| b.velocity[1].abs())
                 .fold(0.0, f64::max);
             assert!(solver.worst_approach() <= 1e-8 * speed);
             for (r, &[pn, pt]) in solver.rows.iter().zip(&solver.impulse) {
-                assert!(pt.abs() <= r.stick_friction * pn * (1.0 + 1e-12) + 1e-15, "{pt} {pn} {} {}", r.stick_friction, out.steps);
+                assert!(pt.abs() <= r.stick_friction * pn * (1.0 + 1e-12) + 1e-15);
             }
         }
     }
@@ -578,31 +589,5 @@ mod tests {
         assert_eq!(out.contacts[0].normal_impulse, 0.0);
         assert_eq!(out.contacts[0].tangent_impulse, 0.0);
         assert!(v.velocity[0].abs() < 1e-12 && (v.velocity[1] - 0.5).abs() < 1e-12);
-    }
-}
-#[cfg(test)]
-mod scratch_stats {
-    use super::tests::*;
-    use super::*;
-    #[test]
-    fn stats() {
-        for (label, friction, equal) in [("mu_s in mu..2mu", true, false), ("mu_s = mu", true, true), ("none", false, false)] {
-            let (mut draw, mut solver) = (xorshift(), PlasticSolver::default());
-            let mut out = ImpactOutcome::default();
-            let (mut errs, mut steps, mut above6, mut above3, mut direct_used) = (vec![], vec![], 0, 0, 0);
-            for _ in 0..1000 {
-                let (bodies, mut contacts) = random_stack(&mut draw, friction);
-                if equal { for c in &mut contacts { c.material.stick_friction = c.material.friction; } }
-                solver.solve_into(&bodies, &contacts, &mut out);
-                let speed = bodies.iter().map(|b| b.velocity[1].abs()).fold(0.0, f64::max);
-                let e = solver.worst_approach() / speed;
-                if e > 1e-6 { above6 += 1; }
-                if e > 1e-3 { above3 += 1; }
-                if out.steps > PlasticSolver::DIRECT_AFTER && out.steps != PlasticSolver::MAX_SWEEPS { direct_used += 1; }
-                errs.push(e); steps.push(out.steps);
-            }
-            errs.sort_by(f64::total_cmp); steps.sort();
-            println!("{label}: median {:.1e}, >1e-6 {above6}, >1e-3 {above3}, steps median {} p90 {} max {}, direct-ish {direct_used}", errs[500], steps[500], steps[900], steps[999]);
-        }
     }
 }
