@@ -49,7 +49,7 @@ pub(crate) struct Lemke {
 impl Lemke {
     /// Solves the LCP of `m` (row-major, n × n) and `q` into `z` (length
     /// n); returns the pivots taken. A pivot element must exceed
-    /// `1e-10` of the largest |M_ij| (and of 1) in magnitude.
+    /// `1e-9` of the largest |M_ij| (and of 1) in magnitude.
     pub(crate) fn solve(
         &mut self,
         m: &[f64],
@@ -68,7 +68,7 @@ impl Lemke {
         };
         self.load(m, q);
         let scale = m.iter().fold(1.0_f64, |s, x| s.max(x.abs()));
-        let eps = 1e-10 * scale;
+        let eps = 1e-9 * scale;
         let z0 = 2 * n;
         // at every vertex of the path all pairs but the entering one are
         // complementary, and that one is non-basic (both zero): a vertex
@@ -85,7 +85,7 @@ impl Lemke {
                 // a ray where z₀ is within 10⁻⁹ of q's scale: the vertex
                 // solves the problem to that rounding (the caller checks
                 // the velocities it gives)
-                return if self.value(z0_row) <= 1e4 * done {
+                return if self.value(z0_row).abs() <= 1e4 * done {
                     self.read(m, q, z);
                     Ok(pivots)
                 } else {
@@ -98,7 +98,7 @@ impl Lemke {
                 self.read(m, q, z);
                 return Ok(pivots + 1);
             }
-            if self.value(z0_row) <= done {
+            if self.value(z0_row).abs() <= done {
                 self.read(m, q, z);
                 return Ok(pivots + 1);
             }
