@@ -657,14 +657,11 @@ fn the_soft_contacts_allowance_bounds_native_rapiers_depth_from_above() {
 /// landing impacts are finished by the plastic fallback (the frame budget
 /// runs out, and the held retry fails). The plastic solve's Gauss–Seidel
 /// sweeps drain the heavy box's approach through the light one by about
-/// m/M a sweep: they stop at their cap with the stack still sinking,
-/// 0.181 of the width beyond the soft contact's sag where native Rapier
-/// stays within 0.13, and the scene is counted. Open (docs/bevy.md, "The
-/// plastic solve"; a direct stage measured and not shipped brought it to
-/// 0.114, within the tolerance, at up to three times the plastic solve's
-/// cost).
+/// m/M a sweep: alone they stopped at their cap with the stack still
+/// sinking, 0.181 of the width beyond the soft contact's sag where native
+/// Rapier stays within 0.13, and the scene was counted. The direct stage
+/// of the plastic solve (docs/bevy.md, "The plastic solve") ends it.
 #[test]
-#[ignore = "open: the plastic fallback leaves this stack sinking (docs/bevy.md, \"The plastic solve\")"]
 fn a_heavy_box_on_a_light_one_finished_plastic_rests_within_the_overlap_tolerance() {
     use topple::stress::scene::{run_scene_combo, scene_violations, tolerance, SceneSpec};
     let c = SceneSpec::quick(13).draw(4);

@@ -8,26 +8,42 @@
 //! sticking, |P_t| = μ P_n when it slides). The velocity change is
 //! Δv = M⁻¹ Jᵀ P (planar bodies, [vx, vy, ω]).
 //!
-//! Solved by projected Gauss–Seidel: each sweep visits the contacts in order,
-//! sets each normal impulse to the value that zeroes its own approach
-//! (clamped at 0), then its tangential impulse to the value that stops its own
-//! slip (clamped to the cone). A normal update, and a tangential one that
-//! sticks or slides at μ_s = μ, minimises the kinetic energy over its own
-//! impulse, so it cannot raise the energy; a slip where μ_s > μ (the impulse
-//! set to μ P_n after a sticking value up to μ_s P_n) can. The solve checks
-//! the energy at its end and, should it have risen, solves the impact
-//! again without friction, so the result never has more kinetic energy
-//! than the bodies brought in (the property the tests check). Sweeps stop
-//! when no impulse changes by more than
-//! [`PlasticSolver::TOLERANCE`] of the group's impulse scale, or after
-//! [`PlasticSolver::MAX_SWEEPS`]; the result then leaves approach speeds below
-//! that tolerance times the velocity scale.
+//! The solve has two stages, one file each:
 //!
-//! Open: where a heavy body lies on a light one, a sweep passes only about
-//! m/M of the heavy body's approach through the light one, and the sweeps
-//! stop at their cap with the stack still sinking (docs/bevy.md, "The
-//! plastic solve": a direct stage for the loaded contacts was measured and
-//! not shipped; the two tests that show it are ignored).
+//! | stage | file | what |
+//! | --- | --- | --- |
+//! | sweeps | `mod.rs` | projected Gauss–Seidel, one contact at a time |
+//! | direct | `direct.rs`, `lemke.rs` | the whole impact as one linear complementarity problem, Lemke's method |
+//!
+//! Each sweep visits the contacts in order, sets each normal impulse to the
+//! value that zeroes its own approach (clamped at 0), then its tangential
+//! impulse to the value that stops its own slip (clamped to the cone). A
+//! normal update, and a tangential one that sticks or slides at μ_s = μ,
+//! minimises the kinetic energy over its own impulse, so it cannot raise
+//! the energy; a slip where μ_s > μ (the impulse set to μ P_n after a
+//! sticking value up to μ_s P_n) can. Sweeps stop when no impulse changes
+//! by more than [`PlasticSolver::TOLERANCE`] of the group's impulse scale.
+//!
+//! Where a heavy body lies on a light one a sweep passes only about m/M of
+//! the heavy body's approach through the light one, and where friction
+//! switches between sticking and slipping the sweeps can cycle: such
+//! solves do not converge in any number of sweeps worth taking. A solve
+//! still unconverged after [`PlasticSolver::DIRECT_AFTER`] sweeps is handed
+//! to the direct stage (direct.rs), which solves the impact exactly (to
+//! rounding) in a number of pivots about half its unknowns, and keeps its
+//! answer if no contact then approaches and the energy has not risen.
+//! Impacts with more than [`PlasticSolver::DIRECT_MAX_UNKNOWNS`] unknowns
+//! (about 40 contact points with friction), a no-slip contact, or a direct
+//! answer that fails its checks go on sweeping up to
+//! [`PlasticSolver::MAX_SWEEPS`].
+//!
+//! The solve checks the energy at its end and, should it have risen (the
+//! stick–slip rule of the sweeps), solves the impact again without
+//! friction, so the result never has more kinetic energy than the bodies
+//! brought in (the property the tests check).
+
+mod direct;
+mod lemke;
 
 use crate::impact::contact::cross;
 use crate::impact::{Body, BodyVelocity, Contact, ContactImpulse, ImpactOutcome};
@@ -71,6 +87,16 @@ pub struct PlasticSolver {
     inv_inertia: Vec<f64>,
     velocity: Vec<[f64; 3]>,
     impulse: Vec<[f64; 2]>,
+    /// The velocities the impact started with.
+    start: Vec<[f64; 3]>,
+    /// The sweeps' state, kept while the direct stage is tried.
+    swept_velocity: Vec<[f64; 3]>,
+    swept_impulse: Vec<[f64; 2]>,
+    /// The largest approach speed at the start (m/s) and the largest
+    /// impulse that stops one contact on its own (N·s).
+    speed: f64,
+    scale: f64,
+    direct: direct::Direct,
 }
 
 impl PlasticSolver {
@@ -85,8 +111,7 @@ impl PlasticSolver {
     /// the sweeps). Inputs are assumed valid (see [`crate::impact`]).
     pub fn solve_into(&mut self, bodies: &[Body], contacts: &[Contact], out: &mut ImpactOutcome) {
         self.load(bodies, contacts);
-        let sweeps = self.iterate();
-        self.write(bodies, out, sweeps);
+        let work = self.solve_loaded(bodies, out);
         if out.gains_energy() {
             // the stick–slip rule (μ_s > μ) is not a projection, and a sweep
             // after a slip can raise the energy; should the whole solve have
@@ -97,29 +122,50 @@ impl PlasticSolver {
                 r.friction = 0.0;
                 r.stick_friction = 0.0;
             }
-            let more = self.iterate();
-            self.write(bodies, out, sweeps + more);
+            let more = self.solve_loaded(bodies, out);
+            out.steps = work + more;
         }
     }
 
-    /// Sweeps until converged or [`Self::MAX_SWEEPS`]; returns the sweeps
-    /// taken.
-    fn iterate(&mut self) -> usize {
-        let scale = self.impulse_scale();
-        let mut sweeps = 0;
-        if scale > 0.0 {
-            while sweeps < Self::MAX_SWEEPS {
-                sweeps += 1;
-                if self.sweep() <= Self::TOLERANCE * scale {
-                    break;
+    /// Sweeps; if they have not converged after [`Self::DIRECT_AFTER`],
+    /// the direct stage (direct.rs), whose answer is kept if it passes its
+    /// checks and gains no energy; otherwise the sweeps go on to
+    /// [`Self::MAX_SWEEPS`]. Writes `out` and returns the work in sweeps.
+    fn solve_loaded(&mut self, bodies: &[Body], out: &mut ImpactOutcome) -> usize {
+        let (mut sweeps, converged) = self.iterate(0, Self::DIRECT_AFTER);
+        let mut extra = 0;
+        if !converged {
+            if let Some(pivots) = self.solve_direct() {
+                extra = self.direct_work(pivots);
+                self.write(bodies, out, sweeps + extra);
+                if !out.gains_energy() {
+                    return sweeps + extra;
                 }
+                self.restore_swept();
+            }
+            sweeps = self.iterate(sweeps, Self::MAX_SWEEPS).0;
+        }
+        self.write(bodies, out, sweeps + extra);
+        sweeps + extra
+    }
+
+    /// Sweeps from `done` until converged or `cap` sweeps in all; returns
+    /// the sweeps taken in all and whether they converged.
+    fn iterate(&mut self, done: usize, cap: usize) -> (usize, bool) {
+        if self.scale <= 0.0 {
+            return (done, true);
+        }
+        let mut sweeps = done;
+        while sweeps < cap {
+            sweeps += 1;
+            if self.sweep() <= Self::TOLERANCE * self.scale {
+                return (sweeps, true);
             }
         }
-        sweeps
+        (sweeps, false)
     }
 
     /// The largest approach speed of a contact (m/s; 0 if none approaches).
-    #[cfg(test)]
     fn worst_approach(&self) -> f64 {
         self.rows
             .iter()
@@ -173,6 +219,10 @@ impl PlasticSolver {
         }
         self.impulse.clear();
         self.impulse.resize(self.rows.len(), [0.0; 2]);
+        self.start.clear();
+        self.start.extend_from_slice(&self.velocity);
+        self.scale = self.impulse_scale();
+        self.speed = self.worst_approach();
     }
 
     /// The largest impulse that stops one approaching contact on its own
@@ -327,10 +377,10 @@ mod tests {
     /// loaded, the closed form is: every body stops, and the normal
     /// impulses through each face sum to the momentum of the bodies above
     /// it. Gauss–Seidel alone drains the heavy box's approach through the
-    /// light ones at about m/M per sweep and stops at the sweep cap with
-    /// the stack still sinking (the heavy box at 0.08 m/s of its 1 m/s).
+    /// light ones at about m/M per sweep and stopped at the sweep cap with
+    /// the stack still sinking (the heavy box at 0.08 m/s of its 1 m/s);
+    /// the direct stage ends it.
     #[test]
-    #[ignore = "open: the sweeps stop at their cap with the stack still sinking (docs/bevy.md, \"The plastic solve\")"]
     fn a_heavy_box_on_light_ones_stops_dead() {
         let (w, h) = (0.2, 0.1);
         let masses = [0.05, 0.025, 10.0];
@@ -431,10 +481,9 @@ mod tests {
     /// impact is the projection of the velocities onto the cone of
     /// non-approaching ones in the energy metric; every solve converges,
     /// ends with no contact approaching (10⁻⁹ of the impact speed) and
-    /// without energy gained. Gauss–Seidel alone leaves most of these
+    /// without energy gained. Gauss–Seidel alone left most of these
     /// stacks still sinking after its 1,000 sweeps.
     #[test]
-    #[ignore = "open: the sweeps stop at their cap with stacks still sinking (docs/bevy.md, \"The plastic solve\")"]
     fn frictionless_random_stacks_end_without_approach() {
         let (mut draw, mut solver) = (xorshift(), PlasticSolver::default());
         let mut out = ImpactOutcome::default();
@@ -455,12 +504,14 @@ mod tests {
         }
     }
 
-    /// Random stacks with friction (μ_s ≥ μ): the solve never raises the
-    /// kinetic energy (the bound every stage keeps, by the guard where the
-    /// stick–slip rule does not), and where it converges no contact
-    /// approaches and no friction leaves its cone.
+    /// Random stacks with friction (μ_s from μ to 2μ, mass ratios up to
+    /// 10⁴): the solve never raises the kinetic energy (the bound every
+    /// stage keeps, by the guard where the stick–slip rule does not), ends
+    /// with no contact approaching (10⁻⁸ of the impact speed) and no
+    /// friction outside its cone. The sweeps alone left 593 of these 1,000
+    /// approaching faster than 10⁻³ of it.
     #[test]
-    fn random_stacks_with_friction_never_gain_energy() {
+    fn random_stacks_with_friction_end_without_approach_or_energy_gain() {
         let (mut draw, mut solver) = (xorshift(), PlasticSolver::default());
         let mut out = ImpactOutcome::default();
         for _ in 0..1000 {
@@ -472,9 +523,6 @@ mod tests {
                 out.kinetic_energy_before,
                 out.kinetic_energy_after
             );
-            if out.steps >= PlasticSolver::MAX_SWEEPS {
-                continue;
-            }
             let speed = bodies
                 .iter()
                 .map(|b| b.velocity[1].abs())
