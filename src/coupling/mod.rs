@@ -8,7 +8,7 @@
 //! | [`ManifoldPoint`], [`PatchRule`], [`for_each_contact_point`] | `patch.rs` | λ points across a flat contact patch (paper Eq. 10, docs/model.md §5) |
 //! | [`PointContact`], [`ImpactGroups`], [`ImpactReport`], [`ContactRecord`] | `group.rs` | which contacts start an impact, the bodies that take part, one solve per group |
 //! | [`FallbackPolicy`], [`GroupSolver`], [`Resolution`] | `fallback.rs` | an impact that cannot finish: held e = 0 retry, then plastic; counted |
-//! | [`PlasticSolver`] | `plastic.rs` | the plastic impact with Coulomb friction (the last stage) |
+//! | [`PlasticSolver`] | `plastic/` | the plastic impact with Coulomb friction (the last stage): sweeps, then a direct LCP solve |
 //! | [`ToppleSettings`] | `settings.rs` | the settings of an impact pass |
 //!
 //! ```
