@@ -353,7 +353,9 @@ impl Engine {
         if event || self.mode_unsettled {
             self.handle_events()?;
         } else {
-            self.project();
+            // the forces of the event test are those at this state and
+            // active set: the projection takes their geometry
+            self.project(true);
             self.eval_k0(false)?;
         }
         self.freeze()?;
