@@ -282,28 +282,33 @@ impl Dynamics {
                 bw = bw.max(s - r);
             }
         }
-        let rhs = std::mem::take(&mut self.band.rhs);
-        self.band.reset(m, bw, bw);
-        self.band.rhs = rhs;
+        self.band.reset_matrix(m, bw, bw);
         self.band.rhs.resize(m, 0.0);
         // M⁻¹ Cᵀ of every unknown once, not once per entry of its column
         self.minv_cols.clear();
-        self.minv_cols
-            .extend(self.unknowns.iter().map(|u| u.col.map(|c| rc.minv(c))));
+        self.minv_cols.extend(
+            self.unknowns
+                .iter()
+                .map(|u| [rc.minv(u.col[0]), rc.minv(u.col[1])]),
+        );
         for r in 0..m {
             let ur = self.unknowns[r];
             let lo = r.saturating_sub(bw);
             let hi = (r + bw).min(m - 1);
             let mut diag = 0.0;
             for s in lo..=hi {
-                let us = &self.unknowns[s];
+                let ub = self.unknowns[s].bodies;
+                let cols = &self.minv_cols[s];
+                // Σ over the bodies the two unknowns share, in the order
+                // (a, b) = (0, 0), (0, 1), (1, 0), (1, 1)
                 let mut v = 0.0;
-                for (a, ba) in ur.bodies.iter().enumerate() {
-                    let Some(ba) = ba else { continue };
-                    for (b, bb) in us.bodies.iter().enumerate() {
-                        if Some(*ba) == *bb {
-                            v += dot3(ur.row[a], self.minv_cols[s][b]);
-                        }
+                for a in 0..2 {
+                    let Some(ba) = ur.bodies[a] else { continue };
+                    if ub[0] == Some(ba) {
+                        v += dot3(ur.row[a], cols[0]);
+                    }
+                    if ub[1] == Some(ba) {
+                        v += dot3(ur.row[a], cols[1]);
                     }
                 }
                 if v != 0.0 {
