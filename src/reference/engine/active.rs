@@ -63,7 +63,7 @@ impl Engine {
         let start = self.y.clone();
         let booked = self.energy.projection;
         for _ in 0..4 {
-            self.project(false);
+            let _ = self.project(false);
             let mut joined = std::mem::take(&mut self.new_active);
             joined.clear();
             {
@@ -106,7 +106,8 @@ impl Engine {
     /// geometry the projection then reuses ([`Dynamics::project`]).
     ///
     /// [`Dynamics::project`]: super::super::dynamics::Dynamics::project
-    pub(super) fn project(&mut self, at_forces: bool) {
+    /// Returns whether the active set changed.
+    pub(super) fn project(&mut self, at_forces: bool) -> bool {
         let before = self.window_energy();
         let (lo, hi) = (self.lo, self.hi);
         let mut act = std::mem::take(&mut self.new_active);
@@ -128,6 +129,7 @@ impl Engine {
         }
         let after = self.window_energy();
         self.energy.projection += before - after;
+        changed
     }
 
     /// The contact mode at the present state (paper Eqs. 18–20): the closed
