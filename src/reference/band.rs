@@ -18,14 +18,11 @@ pub(crate) struct Band {
 }
 
 impl Band {
-    /// Resets to an m × m zero matrix with the given bandwidths.
+    /// Resets to an m × m zero matrix with the given bandwidths and a zero
+    /// right-hand side.
+    #[cfg(test)]
     pub fn reset(&mut self, m: usize, kl: usize, ku: usize) {
-        self.m = m;
-        self.kl = kl;
-        self.ku = ku;
-        self.width = 2 * kl + ku + 1;
-        self.a.clear();
-        self.a.resize(m * self.width, 0.0);
+        self.reset_matrix(m, kl, ku);
         self.rhs.clear();
         self.rhs.resize(m, 0.0);
     }
@@ -34,6 +31,17 @@ impl Band {
     fn idx(&self, r: usize, c: usize) -> usize {
         debug_assert!(c + self.kl >= r && c <= r + self.kl + self.ku);
         r * self.width + (c + self.kl - r)
+    }
+
+    /// [`Band::reset`] of the matrix alone: `rhs` is left as it is (the
+    /// caller fills it).
+    pub fn reset_matrix(&mut self, m: usize, kl: usize, ku: usize) {
+        self.m = m;
+        self.kl = kl;
+        self.ku = ku;
+        self.width = 2 * kl + ku + 1;
+        self.a.clear();
+        self.a.resize(m * self.width, 0.0);
     }
 
     /// Adds `v` to entry (r, c), which must lie inside the band.

@@ -101,6 +101,9 @@ pub(crate) struct Dynamics {
     pub valid: Vec<bool>,
     // buffers of `project`
     proj_start: Vec<f64>,
+    /// Geometry and kinematics of each contact of the projection's active
+    /// list at its start state, aligned with that list.
+    proj_geoms: Vec<(Geom, Kin)>,
     proj_owner: Vec<(usize, bool)>,
     proj_drop: Vec<usize>,
     // buffers of `relaxed_forces`
@@ -279,28 +282,33 @@ impl Dynamics {
                 bw = bw.max(s - r);
             }
         }
-        let rhs = std::mem::take(&mut self.band.rhs);
-        self.band.reset(m, bw, bw);
-        self.band.rhs = rhs;
+        self.band.reset_matrix(m, bw, bw);
         self.band.rhs.resize(m, 0.0);
         // M⁻¹ Cᵀ of every unknown once, not once per entry of its column
         self.minv_cols.clear();
-        self.minv_cols
-            .extend(self.unknowns.iter().map(|u| u.col.map(|c| rc.minv(c))));
+        self.minv_cols.extend(
+            self.unknowns
+                .iter()
+                .map(|u| [rc.minv(u.col[0]), rc.minv(u.col[1])]),
+        );
         for r in 0..m {
             let ur = self.unknowns[r];
             let lo = r.saturating_sub(bw);
             let hi = (r + bw).min(m - 1);
             let mut diag = 0.0;
             for s in lo..=hi {
-                let us = &self.unknowns[s];
+                let ub = self.unknowns[s].bodies;
+                let cols = &self.minv_cols[s];
+                // Σ over the bodies the two unknowns share, in the order
+                // (a, b) = (0, 0), (0, 1), (1, 0), (1, 1)
                 let mut v = 0.0;
-                for (a, ba) in ur.bodies.iter().enumerate() {
-                    let Some(ba) = ba else { continue };
-                    for (b, bb) in us.bodies.iter().enumerate() {
-                        if Some(*ba) == *bb {
-                            v += dot3(ur.row[a], self.minv_cols[s][b]);
-                        }
+                for a in 0..2 {
+                    let Some(ba) = ur.bodies[a] else { continue };
+                    if ub[0] == Some(ba) {
+                        v += dot3(ur.row[a], cols[0]);
+                    }
+                    if ub[1] == Some(ba) {
+                        v += dot3(ur.row[a], cols[1]);
                     }
                 }
                 if v != 0.0 {
@@ -445,6 +453,15 @@ impl Dynamics {
     /// projection repeated: the tangential impulse of a stick row needs a
     /// normal impulse to bound it (|P_t| ≤ μ_s P_n), and a pull leaves it
     /// none. Works on `y` in place; returns whether `active` changed.
+    ///
+    /// `at_forces`: the last [`Dynamics::forces`] call was at this very
+    /// state (`y`, `pos`, the window lo..hi) with this `active` list (the
+    /// same contacts in the same order). Its geometry and kinematics are
+    /// then taken instead of measured again: the same numbers, so the same
+    /// bits. Whatever `at_forces`, the position pass takes the geometry of
+    /// the velocity pass: that pass changes velocities only, and the gap
+    /// and the normal Jacobian row are functions of the positions.
+    #[allow(clippy::too_many_arguments)]
     pub fn project(
         &mut self,
         rc: &RowConst,
@@ -454,11 +471,32 @@ impl Dynamics {
         pos: &[[f64; 3]],
         active: &mut Vec<Active>,
         v_tol: f64,
+        at_forces: bool,
     ) -> bool {
         // buffers kept between calls: this runs every step
         let mut y0 = std::mem::take(&mut self.proj_start);
         let mut owner = std::mem::take(&mut self.proj_owner);
         let mut drop = std::mem::take(&mut self.proj_drop);
+        let mut pg = std::mem::take(&mut self.proj_geoms);
+        pg.clear();
+        if at_forces {
+            debug_assert_eq!(self.geoms.len(), active.len());
+            #[cfg(debug_assertions)]
+            {
+                let view = View { lo, hi, y, pos };
+                for (a, g) in active.iter().zip(&self.geoms) {
+                    let now = rc.geom(&view, a.block, a.slot).expect("slot exists");
+                    debug_assert!(now.gap.to_bits() == g.gap.to_bits() && now.point == g.point);
+                }
+            }
+            pg.extend(self.geoms.iter().copied().zip(self.kins.iter().copied()));
+        } else {
+            let view = View { lo, hi, y, pos };
+            pg.extend(active.iter().map(|a| {
+                let gm = rc.geom(&view, a.block, a.slot).expect("slot exists");
+                (gm, rc.kin(&view, &gm))
+            }));
+        }
         let mut changed = false;
         'passes: for pass in 0..2 {
             let mut rounds = 0;
@@ -481,8 +519,9 @@ impl Dynamics {
                 {
                     let view = View { lo, hi, y, pos };
                     for (c, a) in active.iter().enumerate() {
-                        let gm = rc.geom(&view, a.block, a.slot).expect("slot exists");
-                        let k = rc.kin(&view, &gm);
+                        // the start state's geometry: pass 0 runs at it
+                        // (each round from `y0`), pass 1 at its positions
+                        let (gm, k) = pg[c];
                         let bodies = [view.local(Some(gm.corner)), view.local(gm.face)];
                         if bodies.iter().all(|b| b.is_none()) {
                             continue;
@@ -540,6 +579,7 @@ impl Dynamics {
                         }
                         for &c in drop.iter().rev() {
                             active.remove(c);
+                            pg.remove(c);
                         }
                         continue;
                     }
@@ -561,6 +601,7 @@ impl Dynamics {
         self.proj_start = y0;
         self.proj_owner = owner;
         self.proj_drop = drop;
+        self.proj_geoms = pg;
         changed
     }
 

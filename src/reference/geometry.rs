@@ -251,7 +251,14 @@ fn dot(a: [f64; 2], b: [f64; 2]) -> f64 {
 /// World position of body point `local` of a block at q.
 #[inline]
 pub(crate) fn world_point(q: [f64; 3], local: [f64; 2]) -> [f64; 2] {
-    let r = rot(q[2], local);
+    turned_point(q, turn(q[2]), local)
+}
+
+/// [`world_point`] with (sin φ, cos φ) of the block's angle given: the same
+/// operations, so the same bits.
+#[inline]
+fn turned_point(q: [f64; 3], (s, c): (f64, f64), local: [f64; 2]) -> [f64; 2] {
+    let r = [c * local[0] - s * local[1], s * local[0] + c * local[1]];
     [q[0] + r[0], q[1] + r[1]]
 }
 
@@ -408,10 +415,15 @@ pub(crate) fn near_pair_contacts(
     mut f: impl FnMut(usize),
 ) {
     let (hd, hh) = (0.5 * block.thickness, 0.5 * block.height);
-    for (side, (qc, qf)) in [(Side::Behind, (qi, qj)), (Side::Ahead, (qj, qi))] {
-        let (s, c) = turn(qf[2]);
+    let (turn_i, turn_j) = (turn(qi[2]), turn(qj[2]));
+    for (side, (qc, qf), (tc, tf)) in [
+        (Side::Behind, (qi, qj), (turn_i, turn_j)),
+        (Side::Ahead, (qj, qi), (turn_j, turn_i)),
+    ] {
+        let (s, c) = tf;
         for corner in CORNERS {
-            let p = world_point(qc, corner_local(block, corner));
+            // `world_point` with the corner block's turn looked up once
+            let p = turned_point(qc, tc, corner_local(block, corner));
             let r = [p[0] - qf[0], p[1] - qf[1]];
             // the corner in the face block's frame
             let (u, v) = (c * r[0] + s * r[1], -s * r[0] + c * r[1]);

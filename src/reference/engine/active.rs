@@ -63,7 +63,7 @@ impl Engine {
         let start = self.y.clone();
         let booked = self.energy.projection;
         for _ in 0..4 {
-            self.project();
+            let _ = self.project(false);
             let mut joined = std::mem::take(&mut self.new_active);
             joined.clear();
             {
@@ -101,7 +101,13 @@ impl Engine {
     }
 
     /// Projection onto the active constraints, with its energy change booked.
-    pub(super) fn project(&mut self) {
+    /// `at_forces`: the dynamics hold the forces of the active contacts at
+    /// the present state (`forces_at_y1` of the step just taken), whose
+    /// geometry the projection then reuses ([`Dynamics::project`]).
+    ///
+    /// [`Dynamics::project`]: super::super::dynamics::Dynamics::project
+    /// Returns whether the active set changed.
+    pub(super) fn project(&mut self, at_forces: bool) -> bool {
         let before = self.window_energy();
         let (lo, hi) = (self.lo, self.hi);
         let mut act = std::mem::take(&mut self.new_active);
@@ -115,6 +121,7 @@ impl Engine {
             &self.pos,
             &mut act,
             self.v_tol,
+            at_forces,
         );
         self.new_active = act;
         if changed {
@@ -122,6 +129,7 @@ impl Engine {
         }
         let after = self.window_energy();
         self.energy.projection += before - after;
+        changed
     }
 
     /// The contact mode at the present state (paper Eqs. 18–20): the closed

@@ -166,7 +166,7 @@ impl Engine {
         if self.impacts_at_this_instant >= 2 {
             self.project_unilateral();
         } else {
-            self.project();
+            let _ = self.project(false);
         }
         self.eval_k0(true)
     }

@@ -4,6 +4,7 @@
 
 use super::super::dynamics::Active;
 use super::super::dynamics::{Dynamics, Mode, RowConst, View};
+use super::super::geometry::geom;
 use super::super::settings::Integrator;
 use super::super::stepper::{DOPRI5, HEUN};
 use super::{Engine, EngineError, EventKey};
@@ -53,6 +54,41 @@ impl Engine {
         ) {
             return Err(EngineError::Singular(self.t));
         }
+        self.set_references(after_mode);
+        Ok(())
+    }
+
+    /// The derivative for the next step from the forces of the event test
+    /// at the step's end (`forces_at_y1`, held in the dynamics), taken at
+    /// the state the projection made of it: the positions move with the
+    /// projected velocities, the accelerations and the contact power are
+    /// those of the step's end. The projection moved the state by the
+    /// drift of one step off the constraints, O(Δt³), so the derivative
+    /// differs from one solved at the projected state by as much, and the
+    /// step that follows by O(Δt⁴): below the order of the paper's
+    /// improved Euler (local error O(Δt³)), and one force solve fewer per
+    /// step. The event references follow from the same forces.
+    fn k0_from_step_end(&mut self) -> Result<(), EngineError> {
+        self.k0.resize(self.y.len(), 0.0);
+        let d = &self.dynamics;
+        for b in 0..self.hi - self.lo {
+            for x in 0..3 {
+                self.k0[6 * b + x] = self.y[6 * b + 3 + x];
+                self.k0[6 * b + 3 + x] = d.acc[b][x];
+            }
+        }
+        let last = self.k0.len() - 1;
+        self.k0[last] = -d.power;
+        if !self.k0.iter().all(|v| v.is_finite()) {
+            return Err(EngineError::Singular(self.t));
+        }
+        self.set_references(false);
+        Ok(())
+    }
+
+    /// The forces at the step start (`start_forces`) and the event
+    /// references of the next step, from the forces in the dynamics.
+    fn set_references(&mut self, after_mode: bool) {
         let d = &self.dynamics;
         self.start_forces.clear();
         self.start_forces
@@ -112,7 +148,6 @@ impl Engine {
                 self.ref_slide.push(ref_slide);
             }
         }
-        Ok(())
     }
 
     /// The step's error estimate against the tolerance (Dormand–Prince;
@@ -206,6 +241,14 @@ impl Engine {
             first.and_then(|(key, _)| self.start_margin(key)),
             first.map(|(_, m)| m),
         );
+        // a contact closing: its crossing located on the positions alone
+        // (`close_bracket`), the two ends of that bracket tried first
+        let mut suggested = match (first, fa) {
+            (Some((EventKey::Close(i, slot), mb)), Some(ma)) => self
+                .close_bracket(i, slot, h, ma, mb)
+                .map_or([None; 2], |(lo, hi)| [Some(lo), Some(hi)]),
+            _ => [None; 2],
+        };
         // which end the last trials moved (-1: a, +1: b), for Illinois
         let mut last_side = 0i8;
         let mut widths = [h; 3];
@@ -215,7 +258,11 @@ impl Engine {
             let halving_stalled = trials > 3 && b - a > 0.5 * widths[trials % 3];
             widths[trials % 3] = b - a;
             let mid = 0.5 * (a + b);
+            let suggestion = suggested
+                .iter_mut()
+                .find_map(|s| s.take().filter(|&s| s > a && s < b));
             let t = match (fa, fb) {
+                _ if suggestion.is_some() => suggestion.unwrap_or(mid),
                 (Some(ma), Some(mb)) if !halving_stalled && mb > ma => {
                     let t = a + (b - a) * (-ma / (mb - ma));
                     t.clamp(a + 0.5 * tol, b - 0.5 * tol)
@@ -258,6 +305,85 @@ impl Engine {
         }
         self.probe.watch = None;
         b
+    }
+
+    /// The bracket [lo, hi] (step lengths, s; hi − lo within the event
+    /// time tolerance) in which candidate (i, slot)'s gap, at the end of a
+    /// Heun step of that length from the step start, crosses −ε (its
+    /// closing margin crosses 0), found on the positions alone: a Heun step
+    /// of length t ends at q + t/2 (q̇ + (q̇ + t q̈)) with q̇, q̈ of the
+    /// step start (`k0`), a polynomial in t that needs no force solve. The
+    /// positions are computed by the operations of the written-out Heun
+    /// step (`stepper.rs`), so the gap at a length is the one the full trial
+    /// there measures, to the bit. `ma` ≤ 0 and `mb` > 0 are the margins
+    /// at lengths 0 and `h`. The search is the one of
+    /// [`Engine::locate_event`] (regula falsi, Illinois, halving where it
+    /// stalls) on this one margin. `None` for the Dormand–Prince
+    /// integrator (its positions need the stages' solves), or where the
+    /// contact leaves its face or the search does not close in.
+    fn close_bracket(&self, i: usize, slot: usize, h: f64, ma: f64, mb: f64) -> Option<(f64, f64)> {
+        if !matches!(self.s.integrator, Integrator::Paper { .. }) {
+            return None;
+        }
+        let tol = self.s.event_time_tolerance;
+        let (mut a, mut b, mut fa, mut fb) = (0.0, h, ma, mb);
+        let mut last_side = 0i8;
+        let mut widths = [h; 3];
+        let mut evals = 0usize;
+        while b - a > tol {
+            evals += 1;
+            if evals > 200 {
+                return None;
+            }
+            let halving_stalled = evals > 3 && b - a > 0.5 * widths[evals % 3];
+            widths[evals % 3] = b - a;
+            let t = if !halving_stalled && fb > fa {
+                let t = a + (b - a) * (-fa / (fb - fa));
+                t.clamp(a + 0.5 * tol, b - 0.5 * tol)
+            } else {
+                0.5 * (a + b)
+            };
+            let m = self.close_margin_after(i, slot, t)?;
+            if m > 0.0 {
+                b = t;
+                fb = m;
+                if last_side == 1 {
+                    fa *= 0.5;
+                }
+                last_side = 1;
+            } else {
+                a = t;
+                fa = m;
+                if last_side == -1 {
+                    fb *= 0.5;
+                }
+                last_side = -1;
+            }
+        }
+        Some((a, b))
+    }
+
+    /// The closing margin of candidate (i, slot) (`events_at`: (−ε − δ)/ε)
+    /// at the end of a Heun step of length `t` from the step start, from
+    /// the positions alone (see [`Engine::close_bracket`]); `None` if the
+    /// slot does not exist or its corner is off its face there.
+    fn close_margin_after(&self, i: usize, slot: usize, t: f64) -> Option<f64> {
+        let (lo, hi) = (self.lo, self.hi);
+        let (y, k0) = (&self.y, &self.k0);
+        let q = |j: usize| -> [f64; 3] {
+            if j < lo || j >= hi {
+                return self.pos[j];
+            }
+            let k = 6 * (j - lo);
+            std::array::from_fn(|x| {
+                // the stage's velocity, then the step's end, as `Stages::heun`
+                let stage_v = y[k + 3 + x] + t * (0.0 + 1.0 * k0[k + 3 + x]);
+                y[k + x] + t * (0.0 + 0.5 * k0[k + x] + 0.5 * stage_v)
+            })
+        };
+        let p = &self.rc.p;
+        let g = geom(&p.block, p.lambda_points, self.row.n, i, slot, q)?;
+        g.valid.then(|| (-self.eps_gap - g.gap) / self.eps_gap)
     }
 
     /// The margin of an event condition (`EventProbe`) at the step start,
@@ -353,8 +479,13 @@ impl Engine {
         if event || self.mode_unsettled {
             self.handle_events()?;
         } else {
-            self.project();
-            self.eval_k0(false)?;
+            // the forces of the event test are those at this state and
+            // active set: the projection takes their geometry
+            if self.project(true) {
+                self.eval_k0(false)?;
+            } else {
+                self.k0_from_step_end()?;
+            }
         }
         self.freeze()?;
         self.record();
