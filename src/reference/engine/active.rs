@@ -100,13 +100,13 @@ impl Engine {
         }
     }
 
-    /// Projection onto the active constraints, with its energy change booked.
-    /// `at_forces`: the dynamics hold the forces of the active contacts at
-    /// the present state (`forces_at_y1` of the step just taken), whose
-    /// geometry the projection then reuses ([`Dynamics::project`]).
+    /// Projection onto the active constraints, with its energy change booked;
+    /// returns whether the active set changed. `at_forces`: the dynamics
+    /// hold the forces of the active contacts at the present state
+    /// (`forces_at_y1` of the step just taken), whose geometry the
+    /// projection then reuses ([`Dynamics::project`]).
     ///
     /// [`Dynamics::project`]: super::super::dynamics::Dynamics::project
-    /// Returns whether the active set changed.
     pub(super) fn project(&mut self, at_forces: bool) -> bool {
         let before = self.window_energy();
         let (lo, hi) = (self.lo, self.hi);
