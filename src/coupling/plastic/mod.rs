@@ -30,8 +30,9 @@
 //! solves do not converge in any number of sweeps worth taking. A solve
 //! still unconverged after [`PlasticSolver::DIRECT_AFTER`] sweeps is handed
 //! to the direct stage (direct.rs), which solves the impact exactly (to
-//! rounding) in a number of pivots about half its unknowns, and keeps its
-//! answer if no contact then approaches and the energy has not risen.
+//! rounding) in half to three quarters as many pivots as it has unknowns,
+//! and keeps its answer if no contact then approaches and the energy has
+//! not risen.
 //! Impacts with more than [`PlasticSolver::DIRECT_MAX_UNKNOWNS`] unknowns
 //! (about 40 contact points with friction), a no-slip contact, or a direct
 //! answer that fails its checks go on sweeping up to
