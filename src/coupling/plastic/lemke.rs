@@ -301,13 +301,7 @@ mod tests {
     /// of a singular M need not be unique).
     #[test]
     fn random_semidefinite_problems_are_solved() {
-        let mut seed = 0x9e37_79b9_7f4a_7c15_u64;
-        let mut draw = move || {
-            seed ^= seed << 13;
-            seed ^= seed >> 7;
-            seed ^= seed << 17;
-            (seed >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let mut draw = super::super::tests::xorshift();
         let mut solver = Lemke::default();
         for trial in 0..300 {
             let n = 1 + trial % 15;

@@ -320,7 +320,7 @@ impl PlasticSolver {
 }
 
 #[cfg(test)]
-mod tests {
+pub(super) mod tests {
     use super::*;
     use crate::impact::ContactMaterial;
 
@@ -468,7 +468,8 @@ mod tests {
         (bodies, contacts)
     }
 
-    fn xorshift() -> impl FnMut() -> f64 {
+    /// Uniform draws in [0, 1) from a fixed seed (xorshift64).
+    pub(super) fn xorshift() -> impl FnMut() -> f64 {
         let mut seed = 0x2545_f491_4f6c_dd1d_u64;
         move || {
             seed ^= seed << 13;
