@@ -56,6 +56,10 @@ pub(super) struct Direct {
     z: Vec<f64>,
     /// The unknowns' scales c (the problem is solved for z / c).
     scale: Vec<f64>,
+    /// One row's couplings to every normal row and to every friction
+    /// row's tangent ([`PlasticSolver::couplings`]).
+    w_n: Vec<f64>,
+    w_t: Vec<f64>,
 }
 
 /// How a contact row `r` reads body slot `k`: −1 for its first body, +1
@@ -106,6 +110,21 @@ impl PlasticSolver {
             }
         }
         w
+    }
+
+    /// W between row `ri` along (`di`, arms `ai`) and every normal row
+    /// (into `d.w_n`) and every friction row's tangent (into `d.w_t`).
+    fn couplings(&self, d: &mut Direct, ri: &Row, di: [f64; 2], ai: [f64; 2]) {
+        d.w_n.clear();
+        d.w_n.extend(d.normal.iter().map(|&col| {
+            let rj = &self.rows[col];
+            self.coupling(ri, di, ai, rj, rj.n, [rj.a_rn, rj.b_rn])
+        }));
+        d.w_t.clear();
+        d.w_t.extend(d.friction.iter().map(|&j| {
+            let rj = &self.rows[d.normal[j]];
+            self.coupling(ri, di, ai, rj, rj.t, [rj.a_rt, rj.b_rt])
+        }));
     }
 
     /// Tries the direct stage from the velocities the impact started with
@@ -165,45 +184,33 @@ impl PlasticSolver {
         d.m.resize(n * n, 0.0);
         d.q.clear();
         d.q.resize(n, 0.0);
-        let normal = |r: &Row| (r.n, [r.a_rn, r.b_rn]);
-        let tangent = |r: &Row| (r.t, [r.a_rt, r.b_rt]);
-        // P_n rows
-        for (i, &row) in d.normal.iter().enumerate() {
-            let ri = self.rows[row];
-            let (ni, ai) = normal(&ri);
+        // P_n rows: [W_nn | W_nt | −W_nt | 0]
+        for i in 0..rows {
+            let ri = self.rows[d.normal[i]];
             d.q[i] = self.rate(&ri, ri.n, ri.a_rn, ri.b_rn);
-            for (j, &col) in d.normal.iter().enumerate() {
-                let rj = self.rows[col];
-                let (nj, aj) = normal(&rj);
-                d.m[i * n + j] = self.coupling(&ri, ni, ai, &rj, nj, aj);
-            }
-            for (l, &j) in d.friction.iter().enumerate() {
-                let rj = self.rows[d.normal[j]];
-                let (tj, aj) = tangent(&rj);
-                let w = self.coupling(&ri, ni, ai, &rj, tj, aj);
-                d.m[i * n + rows + l] = w;
-                d.m[i * n + rows + f + l] = -w;
+            self.couplings(d, &ri, ri.n, [ri.a_rn, ri.b_rn]);
+            let row = &mut d.m[i * n..(i + 1) * n];
+            row[..rows].copy_from_slice(&d.w_n);
+            for (l, &w) in d.w_t.iter().enumerate() {
+                row[rows + l] = w;
+                row[rows + f + l] = -w;
             }
         }
-        // β⁺, β⁻ and γ rows
-        for (k, &i) in d.friction.iter().enumerate() {
+        // β⁺ rows: [W_tn | W_tt | −W_tt | I], β⁻ rows their negatives but
+        // for the same +I, γ rows [μ | −I | −I | 0]
+        for k in 0..f {
+            let i = d.friction[k];
             let ri = self.rows[d.normal[i]];
-            let (ti, ai) = tangent(&ri);
             let (plus, minus, slip) = (rows + k, rows + f + k, rows + 2 * f + k);
             let vt = self.rate(&ri, ri.t, ri.a_rt, ri.b_rt);
             d.q[plus] = vt;
             d.q[minus] = -vt;
-            for (j, &col) in d.normal.iter().enumerate() {
-                let rj = self.rows[col];
-                let (nj, aj) = normal(&rj);
-                let w = self.coupling(&ri, ti, ai, &rj, nj, aj);
+            self.couplings(d, &ri, ri.t, [ri.a_rt, ri.b_rt]);
+            for (j, &w) in d.w_n.iter().enumerate() {
                 d.m[plus * n + j] = w;
                 d.m[minus * n + j] = -w;
             }
-            for (l, &j) in d.friction.iter().enumerate() {
-                let rj = self.rows[d.normal[j]];
-                let (tj, aj) = tangent(&rj);
-                let w = self.coupling(&ri, ti, ai, &rj, tj, aj);
+            for (l, &w) in d.w_t.iter().enumerate() {
                 d.m[plus * n + rows + l] = w;
                 d.m[plus * n + rows + f + l] = -w;
                 d.m[minus * n + rows + l] = -w;
