@@ -34,7 +34,8 @@ use std::time::Instant;
 use bevy::prelude::*;
 use bevy_rapier2d::prelude::*;
 use scenes::Target;
-use topple::bevy::{headless_row_app, DominoRow, ImpactResponse, ToppleFrameStats};
+use topple::bevy::{headless_row_app, DominoRow, ImpactResponse, ToppleFrameStats, ToppleImpact};
+use topple::coupling::Resolution;
 use topple::domino::{Preset, RowSpec};
 
 #[path = "../examples/common/show.rs"]
@@ -54,6 +55,8 @@ struct Run {
     rapier_steps: f64,
     impacts: u64,
     fallbacks: u64,
+    /// Of the fallbacks, large groups (`FallbackPolicy::large_group`).
+    large_fallbacks: u64,
     budget_spent: u64,
     native_impacts: u64,
     nan: bool,
@@ -73,6 +76,7 @@ fn measure(app: &mut App, frames: usize, ground_y: f32) -> Run {
         rapier_steps: 0.0,
         impacts: 0,
         fallbacks: 0,
+        large_fallbacks: 0,
         budget_spent: 0,
         native_impacts: 0,
         nan: false,
@@ -89,8 +93,15 @@ fn measure(app: &mut App, frames: usize, ground_y: f32) -> Run {
         if std::env::var("FRAMES_VERBOSE").is_ok() {
             let s = app.world().resource::<ToppleFrameStats>();
             eprintln!(
-                "frame {frame}: {ms:.2} ms, rapier steps {}, impacts {}, work {}",
-                s.rapier_steps, s.impacts, s.work
+                "frame {frame}: {ms:.2} ms, topple {:.2} ms, rapier steps {}, impacts {}, fallbacks {} (large {}), work {}, spent {}: {}",
+                1e3 * s.topple_seconds,
+                s.rapier_steps,
+                s.impacts,
+                s.fallbacks,
+                s.large_group_fallbacks,
+                s.work,
+                s.budget_spent,
+                impacts_of_frame(app)
             );
         }
         run.worst_ms = run.worst_ms.max(ms);
@@ -100,6 +111,7 @@ fn measure(app: &mut App, frames: usize, ground_y: f32) -> Run {
         run.rapier_steps += s.rapier_steps as f64;
         run.impacts += s.impacts;
         run.fallbacks += s.fallbacks;
+        run.large_fallbacks += s.large_group_fallbacks;
         run.budget_spent += s.budget_spent;
         run.native_impacts += s.native_impacts;
     }
@@ -118,6 +130,27 @@ fn measure(app: &mut App, frames: usize, ground_y: f32) -> Run {
         run.below_ground = run.below_ground.max(ground_y - aabb.mins.y);
     }
     run
+}
+
+/// The impacts of the last frame, one word each: free bodies `b`, contact
+/// points `c`, resolver steps `s` and how it ended (`L` the law, `H` held,
+/// `P` plastic, `R` rejected), e.g. `4b12c180sL`.
+fn impacts_of_frame(app: &App) -> String {
+    let Some(messages) = app.world().get_resource::<Messages<ToppleImpact>>() else {
+        return String::new();
+    };
+    let mut words = Vec::new();
+    for m in messages.iter_current_update_messages() {
+        let r = &m.report;
+        let how = match r.resolution {
+            Resolution::Lzb => 'L',
+            Resolution::Held => 'H',
+            Resolution::Plastic => 'P',
+            Resolution::Rejected => 'R',
+        };
+        words.push(format!("{}b{}c{}s{how}", r.bodies, r.contacts, r.steps));
+    }
+    words.join(" ")
 }
 
 /// CPU time the process has used (ms), every thread's (NaN where there
@@ -158,6 +191,25 @@ fn flag<T: std::str::FromStr>(name: &str) -> Option<T> {
     })
 }
 
+/// `--large=BODIES:WORK` (groups of more than BODIES free bodies may spend
+/// WORK) or `--large=none` (no cap on large groups).
+fn large_group(v: &str) -> Option<topple::coupling::LargeGroup> {
+    if v == "none" {
+        return None;
+    }
+    let (b, w) = v
+        .split_once(':')
+        .unwrap_or_else(|| panic!("--large={v}: BODIES:WORK or none"));
+    let n = |x: &str| -> u64 {
+        x.parse()
+            .unwrap_or_else(|_| panic!("--large={v}: not a number"))
+    };
+    Some(topple::coupling::LargeGroup {
+        bodies: n(b) as usize,
+        work: n(w),
+    })
+}
+
 fn with_budget(app: &mut App) {
     let mut config = app.world_mut().resource_mut::<topple::bevy::ToppleConfig>();
     let settings = &mut config.settings;
@@ -169,6 +221,10 @@ fn with_budget(app: &mut App) {
     }
     if let Some(w) = flag("budget") {
         settings.fallback.max_work = Some(w);
+    }
+    if let Some(large) = std::env::args().find_map(|a| a.strip_prefix("--large=").map(String::from))
+    {
+        settings.fallback.large_group = large_group(&large);
     }
 }
 
@@ -227,7 +283,7 @@ fn print(scene: &str, frames: usize, native: &Run, topple: &Run) {
         }
     };
     println!(
-        "| {scene} | {frames} | {:.3} | {:.2} | {} | {:.3} | {:.2} | {} | {:.3} | {:.2} | {:.2} | {:.2} | {} | {} | {} | {} | {} / {} |",
+        "| {scene} | {frames} | {:.3} | {:.2} | {} | {:.3} | {:.2} | {} | {:.3} | {:.2} | {:.2} | {:.2} | {} | {} ({}) | {} | {} | {} / {} |",
         native.mean_ms,
         native.worst_ms,
         native.slow,
@@ -240,6 +296,7 @@ fn print(scene: &str, frames: usize, native: &Run, topple: &Run) {
         topple.worst_ms / native.worst_ms,
         topple.impacts,
         topple.fallbacks,
+        topple.large_fallbacks,
         topple.budget_spent,
         topple.native_impacts,
         sane(native),
@@ -253,7 +310,7 @@ fn main() {
         .filter(|a| !a.starts_with('-'))
         .collect();
     let want = |name: &str| wanted.is_empty() || wanted.iter().any(|w| name.contains(w.as_str()));
-    println!("| scene | frames | native mean (ms) | native worst (ms) | native frames > 1/60 s | topple mean (ms) | topple worst (ms) | topple frames > 1/60 s | topple's own (ms/frame) | topple's Rapier steps per frame | mean ratio | worst ratio | impacts | fallbacks | budget ran out | left to Rapier | below ground (native / topple) |");
+    println!("| scene | frames | native mean (ms) | native worst (ms) | native frames > 1/60 s | topple mean (ms) | topple worst (ms) | topple frames > 1/60 s | topple's own (ms/frame) | topple's Rapier steps per frame | mean ratio | worst ratio | impacts | fallbacks (large groups) | budget ran out | left to Rapier | below ground (native / topple) |");
     println!(
         "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |"
     );
@@ -301,13 +358,14 @@ fn main() {
         print("ideal Domino T row, 1,000 blocks, m", f, &native, &topple);
     }
     if want("show") {
-        let (f, ground) = (600, show::FLOOR_Y);
-        let spawn = |c: &mut Commands, t: Target| {
-            show::domino_show(c, t, 16);
-        };
-        let native = pixel_scene(ImpactResponse::Native, f, ground, spawn);
-        let topple = pixel_scene(ImpactResponse::Topple, f, ground, spawn);
+        let f = 600;
+        let (native, native_fell) = show_scene(ImpactResponse::Native, f);
+        let (topple, topple_fell) = show_scene(ImpactResponse::Topple, f);
         print("domino_show, 16 fronts, px", f, &native, &topple);
+        SHOW_ROWS
+            .lock()
+            .unwrap_or_else(|e| e.into_inner())
+            .extend([native_fell.row("native"), topple_fell.row("topple")]);
     }
     println!();
     println!("| scene (CPU time of the process per frame) | native mean (ms) | native worst (ms) | topple mean (ms) | topple worst (ms) | mean ratio | worst ratio |");
@@ -315,4 +373,84 @@ fn main() {
     for row in CPU_ROWS.lock().unwrap_or_else(|e| e.into_inner()).iter() {
         println!("{row}");
     }
+    let show_rows = SHOW_ROWS.lock().unwrap_or_else(|e| e.into_inner());
+    if !show_rows.is_empty() {
+        println!();
+        println!("| domino_show at the end | fronts' dominoes turned > 10° | growing turned | tower blocks moved > 6 px | steps' dominoes turned |");
+        println!("| --- | --- | --- | --- | --- |");
+        for row in show_rows.iter() {
+            println!("{row}");
+        }
+    }
+}
+
+/// The show's rows of the last table.
+static SHOW_ROWS: std::sync::Mutex<Vec<String>> = std::sync::Mutex::new(Vec::new());
+
+/// What fell in the show: per part, how many of its bodies turned or moved.
+struct ShowFell {
+    /// (fell, of) per part: the fronts, the growing dominoes, the tower,
+    /// the steps.
+    parts: [(usize, usize); 4],
+}
+
+impl ShowFell {
+    fn row(&self, engine: &str) -> String {
+        let p = |k: usize| format!("{} / {}", self.parts[k].0, self.parts[k].1);
+        format!("| {engine} | {} | {} | {} | {} |", p(0), p(1), p(2), p(3))
+    }
+}
+
+/// A body's pose: centre (px) and angle (rad).
+fn pose(app: &mut App, e: Entity) -> (Vec2, f32) {
+    let t = app.world().get::<Transform>(e).copied().unwrap_or_default();
+    (
+        t.translation.truncate(),
+        t.rotation.to_euler(EulerRot::ZYX).0,
+    )
+}
+
+/// The show with 16 fronts, measured, and what fell in it: a domino of a
+/// front, of the growing row or of the steps fell if it turned more than
+/// 10° from its start; a tower block if its centre moved more than half a
+/// block's height (6 px).
+fn show_scene(physics: ImpactResponse, frames: usize) -> (Run, ShowFell) {
+    let mut app = scenes::headless_app(physics);
+    with_budget(&mut app);
+    let mut layout = show::ShowLayout::default();
+    scenes::spawn_in(&mut app, |c| {
+        layout = show::domino_show(
+            c,
+            Target {
+                physics,
+                context: None,
+            },
+            16,
+        );
+    });
+    let fronts: Vec<Entity> = layout
+        .rows
+        .iter()
+        .flat_map(|r| r.dominoes.clone())
+        .collect();
+    let parts = [&fronts, &layout.growing, &layout.tower, &layout.steps];
+    let start: Vec<Vec<(Vec2, f32)>> = parts
+        .iter()
+        .map(|p| p.iter().map(|&e| pose(&mut app, e)).collect())
+        .collect();
+    let run = measure(&mut app, frames, show::FLOOR_Y);
+    let mut fell = ShowFell { parts: [(0, 0); 4] };
+    for (k, part) in parts.iter().enumerate() {
+        let mut n = 0;
+        for (&e, &(c0, a0)) in part.iter().zip(&start[k]) {
+            let (c, a) = pose(&mut app, e);
+            n += usize::from(if k == 2 {
+                c.distance(c0) > 6.0
+            } else {
+                (a - a0).abs() > 10f32.to_radians()
+            });
+        }
+        fell.parts[k] = (n, part.len());
+    }
+    (run, fell)
 }

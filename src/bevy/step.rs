@@ -13,7 +13,8 @@ use bevy_rapier2d::rapier::math::Real;
 
 use super::events::{collect, CollisionCollector, ToppleImpact, ToppleNotice};
 use super::world::{PhysicsClock, ToppleConfig, ToppleFrameStats, ToppleMaterial, ToppleWorld};
-use crate::rapier::f32::StepParts;
+use crate::coupling::Resolution;
+use crate::rapier::f32::{StepParts, ToppleRapier};
 use crate::rapier::ImpactResponse;
 use crate::rapier::ToppleStats;
 
@@ -190,6 +191,7 @@ pub(crate) fn step_contexts(
                     offset,
                     &mut impacts,
                 );
+                frame.large_group_fallbacks += large_group_fallbacks(&world.adapter);
                 offset += f64::from(plan.piece);
             }
         }
@@ -216,6 +218,18 @@ fn mark_interpolation_start(
             interp.end = None;
         }
     }
+}
+
+/// Impacts of the adapter's last step that were large groups under its
+/// policy ([`crate::coupling::FallbackPolicy::large_group`]) and did not
+/// finish by the law.
+fn large_group_fallbacks(adapter: &ToppleRapier) -> u64 {
+    let policy = &adapter.settings().fallback;
+    adapter
+        .last_impacts()
+        .iter()
+        .filter(|r| policy.is_large(r.bodies) && r.resolution != Resolution::Lzb)
+        .count() as u64
 }
 
 /// Adds what one context's adapter did between two readings of its totals.

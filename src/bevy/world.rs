@@ -80,6 +80,12 @@ pub struct ToppleFrameStats {
     /// Impacts that went through the fallback policy this frame (held,
     /// plastic or rejected), those cut short by the work budget included.
     pub fallbacks: u64,
+    /// Of the fallbacks, impacts of large groups
+    /// ([`crate::coupling::FallbackPolicy::large_group`]: more free bodies
+    /// than a domino front's window holds) whose LZB attempts ran out of
+    /// their smaller allowance or failed: a pile or a landing tower solved
+    /// plastic.
+    pub large_group_fallbacks: u64,
     /// Work of the LZB resolver this frame: impulse steps times contact
     /// points, the unit of the budget
     /// ([`crate::coupling::FallbackPolicy::max_work`], per physics step).

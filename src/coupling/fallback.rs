@@ -53,6 +53,17 @@ pub struct FallbackPolicy {
     /// of one call share it.
     #[serde(default)]
     pub max_work: Option<u64>,
+    /// Under a work budget (`max_work` set; ignored without one), an impact
+    /// of more free bodies than [`LargeGroup::bodies`] may spend at most
+    /// [`LargeGroup::work`] of it on LZB attempts, and is then finished by
+    /// the plastic solve: a pile or a landing tower ends plastic at a small
+    /// cost, while an impact of a few bodies (a domino row's front and its
+    /// window, a short cradle) keeps the whole budget and its rebounds.
+    /// `None`: every impact may spend what is left of the budget
+    /// (docs/bevy.md, "Large groups end plastic"). Default
+    /// [`LargeGroup::DEFAULT`].
+    #[serde(default = "LargeGroup::default_some")]
+    pub large_group: Option<LargeGroup>,
 }
 
 impl Default for FallbackPolicy {
@@ -61,7 +72,63 @@ impl Default for FallbackPolicy {
             held_retry_after: 20_000,
             max_steps: 200_000,
             max_work: None,
+            large_group: Some(LargeGroup::DEFAULT),
         }
+    }
+}
+
+/// What counts as a large impact group and how much of the work budget it
+/// may spend ([`FallbackPolicy::large_group`]).
+///
+/// ```
+/// use topple::coupling::{FallbackPolicy, LargeGroup};
+/// let p = FallbackPolicy { max_work: Some(50_000), ..FallbackPolicy::default() };
+/// let big = LargeGroup::DEFAULT.bodies + 1;
+/// assert_eq!(p.allowance(3), Some(50_000)); // a row's front: the whole budget
+/// assert_eq!(p.allowance(big), Some(LargeGroup::DEFAULT.work)); // a pile
+/// // without a budget (exact runs) no impact is capped
+/// assert_eq!(FallbackPolicy::default().allowance(big), None);
+/// ```
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub struct LargeGroup {
+    /// Free bodies a group may have and still count as small.
+    pub bodies: usize,
+    /// Work (LZB steps times contact points, as [`FallbackPolicy::max_work`])
+    /// a large group's LZB attempts may spend together at most.
+    pub work: u64,
+}
+
+impl LargeGroup {
+    /// The default: groups of more than 8 free bodies (two closing bodies
+    /// and the three-contact window on each side, the largest group a
+    /// single front of a domino row makes) may spend 2,000 work units,
+    /// measured in docs/bevy.md ("Large groups end plastic").
+    pub const DEFAULT: LargeGroup = LargeGroup {
+        bodies: 8,
+        work: 2_000,
+    };
+
+    fn default_some() -> Option<LargeGroup> {
+        Some(Self::DEFAULT)
+    }
+}
+
+impl FallbackPolicy {
+    /// The work an impact of `bodies` free bodies may spend on LZB attempts:
+    /// `max_work`, capped by [`FallbackPolicy::large_group`] for a large
+    /// group; `None` without a budget.
+    pub fn allowance(&self, bodies: usize) -> Option<u64> {
+        let budget = self.max_work?;
+        Some(match self.large_group {
+            Some(g) if bodies > g.bodies => budget.min(g.work),
+            _ => budget,
+        })
+    }
+
+    /// Whether an impact of `bodies` free bodies is a large group whose LZB
+    /// attempts are capped ([`FallbackPolicy::large_group`]).
+    pub fn is_large(&self, bodies: usize) -> bool {
+        self.max_work.is_some() && self.large_group.is_some_and(|g| bodies > g.bodies)
     }
 }
 
@@ -177,28 +244,41 @@ impl GroupSolver {
             0
         };
         let mut left = left.saturating_sub(margin);
-        if left > 0 {
+        // a large group's own cap, in steps of this impact (no margin: it
+        // shapes the cost, the frame's budget above is the bound)
+        let mut cap = match policy.large_group {
+            Some(g) if policy.is_large(bodies.len()) => {
+                usize::try_from(g.work / per_step).unwrap_or(usize::MAX)
+            }
+            _ => usize::MAX,
+        };
+        if left > 0 && cap > 0 {
             let first = ImpactSettings {
-                max_steps: budget.min(settings.max_steps).min(left).max(1),
+                max_steps: budget.min(settings.max_steps).min(left).min(cap).max(1),
                 ..*settings
             };
             Self::fresh(out);
             let result = self.lzb.solve_into(bodies, contacts, &first, out);
-            self.charge(out, per_step, &mut left);
+            self.charge(out, per_step, &mut left, &mut cap);
             if !unfinished(&result) && !gains_energy(out) {
                 return result.map(|()| Resolution::Lzb);
             }
         }
         left = left.saturating_sub(margin);
-        if can_hold && left > 0 {
+        if can_hold && left > 0 && cap > 0 {
             let held = ImpactSettings {
                 e0_hold: true,
-                max_steps: policy.max_steps.min(settings.max_steps).min(left).max(1),
+                max_steps: policy
+                    .max_steps
+                    .min(settings.max_steps)
+                    .min(left)
+                    .min(cap)
+                    .max(1),
                 ..*settings
             };
             Self::fresh(out);
             let result = self.lzb.solve_into(bodies, contacts, &held, out);
-            self.charge(out, per_step, &mut left);
+            self.charge(out, per_step, &mut left, &mut cap);
             if !unfinished(&result) && !gains_energy(out) {
                 return result.map(|()| Resolution::Held);
             }
@@ -207,11 +287,19 @@ impl GroupSolver {
         Ok(Resolution::Plastic)
     }
 
-    /// Adds an attempt's steps to the work and takes them from `left`.
-    fn charge(&mut self, out: &mut ImpactOutcome, per_step: u64, left: &mut usize) {
+    /// Adds an attempt's steps to the work and takes them from `left` and
+    /// from the large group's `cap`.
+    fn charge(
+        &mut self,
+        out: &mut ImpactOutcome,
+        per_step: u64,
+        left: &mut usize,
+        cap: &mut usize,
+    ) {
         let steps = out.steps + out.rejected_steps + out.settling_evaluations / SETTLING_PER_STEP;
         self.work += steps as u64 * per_step;
         *left = left.saturating_sub(steps);
+        *cap = cap.saturating_sub(steps);
     }
 
     /// Clears the step counts an attempt that fails its input check leaves
@@ -247,7 +335,7 @@ mod tests {
         let tight = FallbackPolicy {
             held_retry_after: 3,
             max_steps: 4,
-            max_work: None,
+            ..FallbackPolicy::default()
         };
         let how = solver
             .solve_into(
@@ -378,6 +466,197 @@ mod tests {
             solver.last_work()
         );
         assert!(out.kinetic_energy_after <= out.kinetic_energy_before);
+    }
+
+    /// The fastest approach left at any contact after `out` (m/s, ≥ 0):
+    /// n·(v₂ − v₁) at the contact point from the outcome's velocities.
+    fn approach_left(bodies: &[Body], contacts: &[Contact], out: &ImpactOutcome) -> f64 {
+        let at = |i: Option<usize>, p: [f64; 2]| match i {
+            Some(i) => {
+                let (b, v) = (&bodies[i], &out.bodies[i]);
+                let r = [p[0] - b.position[0], p[1] - b.position[1]];
+                [
+                    v.velocity[0] - v.angular_velocity * r[1],
+                    v.velocity[1] + v.angular_velocity * r[0],
+                ]
+            }
+            None => [0.0, 0.0],
+        };
+        contacts
+            .iter()
+            .map(|c| {
+                let (v1, v2) = (at(c.bodies[0], c.point), at(c.bodies[1], c.point));
+                -(c.normal[0] * (v2[0] - v1[0]) + c.normal[1] * (v2[1] - v1[1]))
+            })
+            .fold(0.0, f64::max)
+    }
+
+    /// Total linear momentum of the bodies (kg·m/s), before or after.
+    fn momentum(bodies: &[Body], after: Option<&ImpactOutcome>) -> [f64; 2] {
+        let mut p = [0.0; 2];
+        for (i, b) in bodies.iter().enumerate() {
+            let v = after.map_or(b.velocity, |o| o.bodies[i].velocity);
+            p[0] += b.mass * v[0];
+            p[1] += b.mass * v[1];
+        }
+        p
+    }
+
+    /// `n` equal balls (1 kg, r = 0.05 m) touching in a line along x, the
+    /// first at 1 m/s: a Newton's cradle with restitution `e`, no walls.
+    fn cradle(n: usize, e: f64) -> (Vec<Body>, Vec<Contact>) {
+        let bodies: Vec<Body> = (0..n)
+            .map(|i| {
+                let b = Body::new(1.0, 0.001).with_position([0.1 * i as f64, 0.0]);
+                if i == 0 {
+                    b.with_velocity([1.0, 0.0])
+                } else {
+                    b
+                }
+            })
+            .collect();
+        let m = ContactMaterial::hertz(1e8).with_restitution(e);
+        let contacts = (1..n)
+            .map(|i| {
+                Contact::new(
+                    [Some(i - 1), Some(i)],
+                    [0.1 * i as f64 - 0.05, 0.0],
+                    [1.0, 0.0],
+                    m,
+                )
+            })
+            .collect();
+        (bodies, contacts)
+    }
+
+    /// Under a frame budget, the default policy's large groups.
+    fn budgeted() -> FallbackPolicy {
+        FallbackPolicy {
+            max_work: Some(crate::coupling::ToppleSettings::DEFAULT_STEP_WORK),
+            ..FallbackPolicy::default()
+        }
+    }
+
+    /// 15 boxes and 33 contact points of the pile landing on one another
+    /// (captured from the pile scene; tests/impact/rest.rs), small enough
+    /// for the plastic solve's direct stage.
+    fn landing() -> (Vec<Body>, Vec<Contact>) {
+        let input: serde_json::Value = serde_json::from_str(include_str!(
+            "../../tests/data/pile-landing-33-contacts.json"
+        ))
+        .expect("the captured impact");
+        let bodies = serde_json::from_value(input["bodies"].clone()).expect("bodies");
+        let contacts = serde_json::from_value(input["contacts"].clone()).expect("contacts");
+        (bodies, contacts)
+    }
+
+    #[test]
+    fn a_large_group_ends_plastic_within_its_cap_without_approach_or_energy_gain() {
+        let (bodies, contacts) = landing();
+        // ended at a hundredth of the fastest body's speed, as the engines
+        // end an impact at their rest fraction
+        let fastest = bodies
+            .iter()
+            .map(|b| b.velocity[0].hypot(b.velocity[1]))
+            .fold(0.0, f64::max);
+        let settings = ImpactSettings {
+            rest_speed: 1e-2 * fastest,
+            ..ImpactSettings::adaptive(1e-6)
+        };
+        let per_step = contacts.len() as u64;
+        let large = LargeGroup::DEFAULT;
+        assert!(bodies.len() > large.bodies);
+        let mut out = ImpactOutcome::default();
+        let mut solver = GroupSolver::default();
+        // with the frame budget alone it spends most of the budget before
+        // the plastic solve (its law needs about twice the budget)
+        let uncapped = FallbackPolicy {
+            large_group: None,
+            ..budgeted()
+        };
+        solver
+            .solve_into(&bodies, &contacts, &settings, &uncapped, &mut out)
+            .unwrap();
+        assert!(
+            solver.last_work() > 10 * large.work,
+            "{}",
+            solver.last_work()
+        );
+        let how = solver
+            .solve_into(&bodies, &contacts, &settings, &budgeted(), &mut out)
+            .unwrap();
+        assert_eq!(how, Resolution::Plastic);
+        // the cap, overshot by at most the last step and two settlings of
+        // the modes before the check (4 + 2 (points + patches) evaluations
+        // each, patches ≤ points)
+        let settle = (4 + 4 * per_step) / SETTLING_PER_STEP as u64 + 1;
+        assert!(
+            solver.last_work() <= large.work + (1 + 2 * settle) * per_step,
+            "{}",
+            solver.last_work()
+        );
+        // the plastic outcome: no contact approaching faster than 10⁻⁸ of
+        // the impact speed (the plastic solve's own test asks the same of
+        // its random stacks), no energy created
+        let rest = ImpactOutcome {
+            bodies: bodies
+                .iter()
+                .map(|b| crate::impact::BodyVelocity {
+                    velocity: b.velocity,
+                    angular_velocity: b.angular_velocity,
+                })
+                .collect(),
+            ..ImpactOutcome::default()
+        };
+        let speed = approach_left(&bodies, &contacts, &rest);
+        assert!(speed > 0.0);
+        let left = approach_left(&bodies, &contacts, &out);
+        assert!(left <= 1e-8 * speed, "{left} of {speed}");
+        let ke0: f64 = bodies.iter().map(Body::kinetic_energy).sum();
+        let ke1: f64 = bodies
+            .iter()
+            .zip(&out.bodies)
+            .map(|(b, v)| {
+                0.5 * b.mass * (v.velocity[0].powi(2) + v.velocity[1].powi(2))
+                    + 0.5 * b.inertia * v.angular_velocity.powi(2)
+            })
+            .sum();
+        assert!(ke1 <= ke0 * (1.0 + 1e-12), "{ke1} > {ke0}");
+    }
+
+    #[test]
+    fn small_groups_and_cheap_large_ones_keep_the_law() {
+        let settings = ImpactSettings::adaptive(1e-6);
+        let mut solver = GroupSolver::default();
+        let (mut a, mut b) = (ImpactOutcome::default(), ImpactOutcome::default());
+        for n in [4, LargeGroup::DEFAULT.bodies + 4] {
+            let (bodies, contacts) = cradle(n, 1.0);
+            let how = solver
+                .solve_into(&bodies, &contacts, &settings, &budgeted(), &mut a)
+                .unwrap();
+            let uncapped = FallbackPolicy {
+                large_group: None,
+                ..budgeted()
+            };
+            solver
+                .solve_into(&bodies, &contacts, &settings, &uncapped, &mut b)
+                .unwrap();
+            // the law, the same bits as without the cap
+            assert_eq!(how, Resolution::Lzb, "{n} balls");
+            assert_eq!(a.bodies, b.bodies, "{n} balls");
+            // an elastic cradle: momentum kept, energy kept to the
+            // tolerance, the last ball leaves with the first one's speed
+            let (p0, p1) = (momentum(&bodies, None), momentum(&bodies, Some(&a)));
+            assert!(
+                (p1[0] - p0[0]).abs() < 1e-12 && p1[1].abs() < 1e-12,
+                "{p1:?}"
+            );
+            let ke0: f64 = bodies.iter().map(Body::kinetic_energy).sum();
+            assert!(
+                (a.kinetic_energy_after - ke0).abs() < 1e-5 * ke0,
+                "{n} balls"
+            );
+        }
     }
 
     #[test]

@@ -33,7 +33,7 @@ mod patch;
 mod plastic;
 mod settings;
 
-pub use fallback::{gains_energy, FallbackPolicy, GroupSolver, Resolution};
+pub use fallback::{gains_energy, FallbackPolicy, GroupSolver, LargeGroup, Resolution};
 pub use group::{
     normal_velocity, seed_approach, ContactRecord, ImpactGroups, ImpactReport, PointContact,
 };
