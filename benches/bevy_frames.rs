@@ -392,12 +392,24 @@ struct ShowFell {
     /// (fell, of) per part: the fronts, the growing dominoes, the tower,
     /// the steps.
     parts: [(usize, usize); 4],
+    /// The tower's blocks: mean distance their centres moved, and the
+    /// width of the pile they make (px, extent of their centres in x).
+    tower_moved: f32,
+    tower_width: f32,
 }
 
 impl ShowFell {
     fn row(&self, engine: &str) -> String {
         let p = |k: usize| format!("{} / {}", self.parts[k].0, self.parts[k].1);
-        format!("| {engine} | {} | {} | {} | {} |", p(0), p(1), p(2), p(3))
+        format!(
+            "| {engine} | {} | {} | {} ({:.0} px on average, {:.0} px wide) | {} |",
+            p(0),
+            p(1),
+            p(2),
+            self.tower_moved,
+            self.tower_width,
+            p(3)
+        )
     }
 }
 
@@ -439,11 +451,20 @@ fn show_scene(physics: ImpactResponse, frames: usize) -> (Run, ShowFell) {
         .map(|p| p.iter().map(|&e| pose(&mut app, e)).collect())
         .collect();
     let run = measure(&mut app, frames, show::FLOOR_Y);
-    let mut fell = ShowFell { parts: [(0, 0); 4] };
+    let mut fell = ShowFell {
+        parts: [(0, 0); 4],
+        tower_moved: 0.0,
+        tower_width: 0.0,
+    };
+    let (mut x0, mut x1) = (f32::INFINITY, f32::NEG_INFINITY);
     for (k, part) in parts.iter().enumerate() {
         let mut n = 0;
         for (&e, &(c0, a0)) in part.iter().zip(&start[k]) {
             let (c, a) = pose(&mut app, e);
+            if k == 2 {
+                fell.tower_moved += c.distance(c0) / part.len() as f32;
+                (x0, x1) = (x0.min(c.x), x1.max(c.x));
+            }
             n += usize::from(if k == 2 {
                 c.distance(c0) > 6.0
             } else {
@@ -452,5 +473,6 @@ fn show_scene(physics: ImpactResponse, frames: usize) -> (Run, ShowFell) {
         }
         fell.parts[k] = (n, part.len());
     }
+    fell.tower_width = x1 - x0;
     (run, fell)
 }

@@ -83,3 +83,90 @@ fn the_default_budget_bounds_every_step_of_a_pile() {
     }
     assert!(spent > 0, "no step ran out of its budget");
 }
+
+/// The default budget's cap on large groups
+/// (`FallbackPolicy::large_group`): in the pile, every impact of more free
+/// bodies than the cap's size that the law finished stayed within the cap's
+/// work (accepted steps times contact points, plus the last step and two
+/// settlings of the modes the resolver may take past it), the others ended
+/// plastic without creating energy (checked by `step_work` for every
+/// impact), and large groups did end plastic.
+#[test]
+fn large_groups_of_a_pile_end_plastic_within_their_cap() {
+    let mut sw = build(&pile(), ImpactResponse::Topple).unwrap();
+    let policy = sw.topple.settings().fallback;
+    let large = policy.large_group.expect("the default caps large groups");
+    assert!(policy.max_work.is_some());
+    let (mut capped, mut lzb) = (0, 0);
+    for _ in 0..(2.0 / sw.world.integration_parameters.dt).round() as usize {
+        for r in sw.step() {
+            if r.bodies <= large.bodies {
+                continue;
+            }
+            match r.resolution {
+                Resolution::Lzb => {
+                    let c = r.contacts as u64;
+                    let settle = (4 + 4 * c) / 6 + 1;
+                    let work = r.steps as u64 * c;
+                    assert!(
+                        work <= large.work + (1 + 2 * settle) * c,
+                        "a large group's law spent {work}: {r:?}"
+                    );
+                    lzb += 1;
+                }
+                Resolution::Plastic => capped += 1,
+                _ => {}
+            }
+        }
+    }
+    assert!(capped > 0, "no large group ended plastic (law: {lzb})");
+}
+
+/// The twelve rows of docs/game-rate.md (six rows, both builds; 100 blocks
+/// at 1/60 s) under the default work budget and its cap on large groups end
+/// with the same bits as the unbounded accuracy runs of `topple chain
+/// --engine rapier`: no row step spends the budget, and no row impact is a
+/// large group.
+#[test]
+fn the_budget_and_its_large_group_cap_leave_the_rows_untouched() {
+    use topple::domino::{Preset, RowSpec};
+    use topple::engines::{RapierRow, RowEngine};
+    use topple::rapier::scene::SolverSpec;
+    use topple::rapier::Precision;
+    let rows = [
+        (Preset::T.params().ideal(), 0.25),
+        (Preset::T.params().ideal(), 0.45),
+        (Preset::X.params(), 0.3),
+        (Preset::X.params(), 0.52),
+        (Preset::T.params(), 0.3),
+        (Preset::P.params(), 0.3),
+    ];
+    for (p, s) in rows {
+        let row = RowSpec::new(p, s * p.block.height, 100, 1.0);
+        for precision in [Precision::F64, Precision::F32] {
+            let run = |max_work| {
+                let engine = RapierRow {
+                    precision,
+                    solver: SolverSpec {
+                        dt: 1.0 / 60.0,
+                        max_group_hops: Some(ToppleSettings::DEFAULT_WINDOW),
+                        max_work,
+                        ..SolverSpec::default()
+                    },
+                    ..RapierRow::new(ImpactResponse::Topple, 1.0 / 60.0)
+                };
+                engine.run(&row, &mut |_| {}).unwrap()
+            };
+            let (exact, game) = (run(WorkBudget::Unbounded), run(WorkBudget::default()));
+            let what = format!("s/h {s}, {precision:?}");
+            assert!(exact.natural_speed.is_some(), "{what}: no wave");
+            assert_eq!(exact.natural_speed, game.natural_speed, "{what}");
+            assert_eq!(exact.hit_times, game.hit_times, "{what}");
+            assert_eq!(
+                (exact.impacts, exact.impact_fallbacks),
+                (game.impacts, game.impact_fallbacks),
+                "{what}"
+            );
+        }
+    }
+}
