@@ -315,3 +315,53 @@ fn despawns_sensors_and_kinematic_bodies_in_a_pile() {
         assert!(t.translation.is_finite() && v.linear.is_finite() && v.angular.is_finite());
     }
 }
+
+/// The frame statistics count the large groups the default policy ends
+/// plastic (`FallbackPolicy::large_group`): in a pile dropped in layers,
+/// each frame's `large_group_fallbacks` is the number of that frame's
+/// `ToppleImpact` messages of more free bodies than the policy's size that
+/// did not end by the law, some frames have them, and none of those
+/// impacts created energy.
+#[test]
+fn large_groups_of_a_pile_end_plastic_and_are_counted() {
+    use topple::bevy::ToppleImpact;
+    use topple::coupling::{LargeGroup, Resolution};
+    let mut app = scenes::headless_app(ImpactResponse::Topple);
+    let target = Target {
+        physics: ImpactResponse::Topple,
+        context: None,
+    };
+    scenes::spawn_in(&mut app, |c| {
+        scenes::pile_in_layers(c, target, 6, 10);
+    });
+    let large = LargeGroup::DEFAULT;
+    let mut counted = 0;
+    for frame in 0..120 {
+        app.update();
+        let messages: Vec<ToppleImpact> = app
+            .world_mut()
+            .resource_mut::<Messages<ToppleImpact>>()
+            .drain()
+            .collect();
+        let plastic: Vec<&ToppleImpact> = messages
+            .iter()
+            .filter(|m| m.report.bodies > large.bodies && m.report.resolution != Resolution::Lzb)
+            .collect();
+        let stats = app.world().resource::<ToppleFrameStats>();
+        assert_eq!(
+            stats.large_group_fallbacks,
+            plastic.len() as u64,
+            "frame {frame}"
+        );
+        assert!(stats.large_group_fallbacks <= stats.fallbacks);
+        for m in plastic {
+            let r = &m.report;
+            assert!(
+                r.kinetic_energy_after <= r.kinetic_energy_before * (1.0 + 1e-9) + 1e-12,
+                "frame {frame}: {r:?}"
+            );
+        }
+        counted += stats.large_group_fallbacks;
+    }
+    assert!(counted > 0, "no large group ended plastic");
+}
