@@ -10,14 +10,6 @@ use super::{
     body_index, dynamic_parent, v2, ImpactContact, ImpactEvent, ImpactPass, World, NO_SLOT,
 };
 
-/// Contact sweeps of the plastic solve (its direct stage counted in
-/// sweeps) that cost one unit of the work budget (an LZB step of one
-/// contact point). Callgrind on the frame bench (`bevy_frames pile` and
-/// `show`, docs/bevy.md "Large groups end plastic"): the LZB resolver took
-/// 2,090–2,590 instructions per work unit, the plastic solve 241 per
-/// contact sweep.
-const PLASTIC_SWEEPS_PER_WORK: u64 = 10;
-
 impl ImpactPass {
     /// Resolves the impacts at time `t`: the candidates closing then, with
     /// the group around them; then lets the changed bodies move on.
@@ -87,14 +79,12 @@ impl ImpactPass {
         let work = self.groups.work();
         self.work += work;
         // the plastic fallback's sweeps (each over the impact's contact
-        // points) spend the budget too, though they are not LZB work: at
-        // what they cost in its unit (PLASTIC_SWEEPS_PER_WORK)
+        // points) spend the budget too, though they are not LZB work
         let sweeps: u64 = self.groups.reports()[..groups]
             .iter()
             .filter(|r| r.resolution == Resolution::Plastic)
             .map(|r| (r.steps * r.contacts) as u64)
-            .sum::<u64>()
-            .div_ceil(PLASTIC_SWEEPS_PER_WORK);
+            .sum();
         if let Some(left) = &mut self.work_left {
             *left = left.saturating_sub(work + sweeps);
         }
