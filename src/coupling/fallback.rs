@@ -130,6 +130,19 @@ impl FallbackPolicy {
     pub fn is_large(&self, bodies: usize) -> bool {
         self.max_work.is_some() && self.large_group.is_some_and(|g| bodies > g.bodies)
     }
+
+    /// A large group's cap in LZB steps of an impact of `per_step` contact
+    /// points (`usize::MAX` for any other impact). No margin is kept back
+    /// from it as from the frame's budget: the cap shapes the cost, the
+    /// frame's budget is the bound.
+    fn large_cap_steps(&self, bodies: usize, per_step: u64) -> usize {
+        match self.large_group {
+            Some(g) if self.is_large(bodies) => {
+                usize::try_from(g.work / per_step).unwrap_or(usize::MAX)
+            }
+            _ => usize::MAX,
+        }
+    }
 }
 
 /// How an impact was resolved (see the module table).
@@ -244,14 +257,7 @@ impl GroupSolver {
             0
         };
         let mut left = left.saturating_sub(margin);
-        // a large group's own cap, in steps of this impact (no margin: it
-        // shapes the cost, the frame's budget above is the bound)
-        let mut cap = match policy.large_group {
-            Some(g) if policy.is_large(bodies.len()) => {
-                usize::try_from(g.work / per_step).unwrap_or(usize::MAX)
-            }
-            _ => usize::MAX,
-        };
+        let mut cap = policy.large_cap_steps(bodies.len(), per_step);
         if left > 0 && cap > 0 {
             let first = ImpactSettings {
                 max_steps: budget.min(settings.max_steps).min(left).min(cap).max(1),
