@@ -224,11 +224,10 @@ fn mark_interpolation_start(
 /// policy ([`crate::coupling::FallbackPolicy::large_group`]) and did not
 /// finish by the law.
 fn large_group_fallbacks(adapter: &ToppleRapier) -> u64 {
-    let policy = &adapter.settings().fallback;
     adapter
         .last_impacts()
         .iter()
-        .filter(|r| policy.is_large(r.bodies) && r.resolution != Resolution::Lzb)
+        .filter(|r| r.large_group && r.resolution != Resolution::Lzb)
         .count() as u64
 }
 

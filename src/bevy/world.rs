@@ -82,9 +82,9 @@ pub struct ToppleFrameStats {
     pub fallbacks: u64,
     /// Of the fallbacks, impacts of large groups
     /// ([`crate::coupling::FallbackPolicy::large_group`]: more free bodies
-    /// than a domino front's window holds) whose LZB attempts ran out of
-    /// their smaller allowance or failed: a pile or a landing tower solved
-    /// plastic.
+    /// than a domino front's window holds, some touching three or more
+    /// others) whose LZB attempts ran out of their smaller allowance or
+    /// failed: a pile solved plastic.
     pub large_group_fallbacks: u64,
     /// Work of the LZB resolver this frame: impulse steps times contact
     /// points, the unit of the budget

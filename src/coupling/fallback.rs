@@ -54,11 +54,13 @@ pub struct FallbackPolicy {
     #[serde(default)]
     pub max_work: Option<u64>,
     /// Under a work budget (`max_work` set; ignored without one), an impact
-    /// of more free bodies than [`LargeGroup::bodies`] may spend at most
-    /// [`LargeGroup::work`] of it on LZB attempts, and is then finished by
-    /// the plastic solve: a pile or a landing tower ends plastic at a small
-    /// cost, while an impact of a few bodies (a domino row's front and its
-    /// window, a short cradle) keeps the whole budget and its rebounds.
+    /// of more free bodies than [`LargeGroup::bodies`] in which some body
+    /// touches three or more others may spend at most [`LargeGroup::work`]
+    /// of it on LZB attempts, and is then finished by the plastic solve: a
+    /// pile ends plastic at a small cost, while an impact of a few bodies (a
+    /// domino row's front and its window) or a chain of any length (a
+    /// Newton's cradle, a tower stacked flat, a leaning train: each body
+    /// touching at most two others) keeps the whole budget and its rebounds.
     /// `None`: every impact may spend what is left of the budget
     /// (docs/bevy.md, "Large groups end plastic"). Default
     /// [`LargeGroup::DEFAULT`].
@@ -78,16 +80,19 @@ impl Default for FallbackPolicy {
 }
 
 /// What counts as a large impact group and how much of the work budget it
-/// may spend ([`FallbackPolicy::large_group`]).
+/// may spend ([`FallbackPolicy::large_group`]): more free bodies than
+/// [`LargeGroup::bodies`], and a branch (a free body touching three or more
+/// other free bodies), as in a pile; a chain of any length is not large.
 ///
 /// ```
 /// use topple::coupling::{FallbackPolicy, LargeGroup};
 /// let p = FallbackPolicy { max_work: Some(50_000), ..FallbackPolicy::default() };
 /// let big = LargeGroup::DEFAULT.bodies + 1;
-/// assert_eq!(p.allowance(3), Some(50_000)); // a row's front: the whole budget
-/// assert_eq!(p.allowance(big), Some(LargeGroup::DEFAULT.work)); // a pile
+/// assert_eq!(p.allowance(3, true), Some(50_000)); // a row's front: the whole budget
+/// assert_eq!(p.allowance(big, true), Some(LargeGroup::DEFAULT.work)); // a pile
+/// assert_eq!(p.allowance(big, false), Some(50_000)); // a long cradle: a chain
 /// // without a budget (exact runs) no impact is capped
-/// assert_eq!(FallbackPolicy::default().allowance(big), None);
+/// assert_eq!(FallbackPolicy::default().allowance(big, true), None);
 /// ```
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 pub struct LargeGroup {
@@ -114,35 +119,61 @@ impl LargeGroup {
 }
 
 impl FallbackPolicy {
-    /// The work an impact of `bodies` free bodies may spend on LZB attempts:
-    /// `max_work`, capped by [`FallbackPolicy::large_group`] for a large
-    /// group; `None` without a budget.
-    pub fn allowance(&self, bodies: usize) -> Option<u64> {
+    /// The work an impact of `bodies` free bodies, `branched` or a chain
+    /// ([`LargeGroup`]), may spend on LZB attempts: `max_work`, capped by
+    /// [`FallbackPolicy::large_group`] for a large group; `None` without a
+    /// budget.
+    pub fn allowance(&self, bodies: usize, branched: bool) -> Option<u64> {
         let budget = self.max_work?;
         Some(match self.large_group {
-            Some(g) if bodies > g.bodies => budget.min(g.work),
+            Some(g) if self.is_large(bodies, branched) => budget.min(g.work),
             _ => budget,
         })
     }
 
-    /// Whether an impact of `bodies` free bodies is a large group whose LZB
-    /// attempts are capped ([`FallbackPolicy::large_group`]).
-    pub fn is_large(&self, bodies: usize) -> bool {
-        self.max_work.is_some() && self.large_group.is_some_and(|g| bodies > g.bodies)
+    /// Whether an impact of `bodies` free bodies, `branched` or a chain, is
+    /// a large group whose LZB attempts are capped
+    /// ([`FallbackPolicy::large_group`]).
+    pub fn is_large(&self, bodies: usize, branched: bool) -> bool {
+        branched && self.max_work.is_some() && self.large_group.is_some_and(|g| bodies > g.bodies)
     }
 
     /// A large group's cap in LZB steps of an impact of `per_step` contact
     /// points (`usize::MAX` for any other impact). No margin is kept back
     /// from it as from the frame's budget: the cap shapes the cost, the
     /// frame's budget is the bound.
-    fn large_cap_steps(&self, bodies: usize, per_step: u64) -> usize {
+    fn large_cap_steps(&self, large: bool, per_step: u64) -> usize {
         match self.large_group {
-            Some(g) if self.is_large(bodies) => {
-                usize::try_from(g.work / per_step).unwrap_or(usize::MAX)
-            }
+            Some(g) if large => usize::try_from(g.work / per_step).unwrap_or(usize::MAX),
             _ => usize::MAX,
         }
     }
+}
+
+/// Whether some free body of an impact group touches three or more other
+/// free bodies (the group's contact graph branches, as a pile's does; a
+/// chain's bodies each touch at most two). `pairs` is scratch space.
+fn branches(contacts: &[Contact], pairs: &mut Vec<(usize, usize)>) -> bool {
+    pairs.clear();
+    pairs.extend(contacts.iter().filter_map(|c| match c.bodies {
+        [Some(a), Some(b)] if a != b => Some((a.min(b), a.max(b))),
+        _ => None,
+    }));
+    if pairs.len() < 3 {
+        return false;
+    }
+    pairs.sort_unstable();
+    pairs.dedup();
+    // each distinct pair counted at both of its bodies: the ends as a list
+    let n = pairs.len();
+    for i in 0..n {
+        let (a, b) = pairs[i];
+        pairs.push((a, b));
+        pairs.push((b, a));
+    }
+    let ends = &mut pairs[n..];
+    ends.sort_unstable_by_key(|e| e.0);
+    ends.windows(3).any(|w| w[0].0 == w[2].0)
 }
 
 /// How an impact was resolved (see the module table).
@@ -181,6 +212,10 @@ pub struct GroupSolver {
     plastic: PlasticSolver,
     /// Work of the last impact's LZB attempts (see [`FallbackPolicy::max_work`]).
     work: u64,
+    /// Whether the last impact was a large group ([`FallbackPolicy::large_group`]).
+    large: bool,
+    /// Scratch: the body pairs of a group's contacts.
+    pairs: Vec<(usize, usize)>,
 }
 
 /// [`ImpactOutcome::gains_energy`]: an LZB result that creates energy is a
@@ -227,6 +262,12 @@ impl GroupSolver {
         self.work
     }
 
+    /// Whether the last [`GroupSolver::solve_into`] was a large group, its
+    /// LZB attempts capped ([`FallbackPolicy::large_group`]).
+    pub fn last_was_large(&self) -> bool {
+        self.large
+    }
+
     fn by_policy(
         &mut self,
         bodies: &[Body],
@@ -236,6 +277,7 @@ impl GroupSolver {
         out: &mut ImpactOutcome,
     ) -> Result<Resolution, ImpactError> {
         self.work = 0;
+        self.large = false;
         let per_step = contacts.len().max(1) as u64;
         // steps left to all attempts together under `max_work`
         let left = policy.max_work.map_or(usize::MAX, |w| {
@@ -257,7 +299,8 @@ impl GroupSolver {
             0
         };
         let mut left = left.saturating_sub(margin);
-        let mut cap = policy.large_cap_steps(bodies.len(), per_step);
+        self.large = policy.is_large(bodies.len(), branches(contacts, &mut self.pairs));
+        let mut cap = policy.large_cap_steps(self.large, per_step);
         if left > 0 && cap > 0 {
             let first = ImpactSettings {
                 max_steps: budget.min(settings.max_steps).min(left).min(cap).max(1),
@@ -631,7 +674,55 @@ mod tests {
     }
 
     #[test]
-    fn small_groups_and_cheap_large_ones_keep_the_law() {
+    fn a_pile_branches_and_a_chain_does_not() {
+        let mut pairs = Vec::new();
+        let (_, chain) = cradle(20, 1.0);
+        assert!(!branches(&chain, &mut pairs));
+        // the captured pile landing: some box touches three or more others
+        let (_, pile) = landing();
+        assert!(branches(&pile, &mut pairs));
+        // a star of three bodies around one, each pair touching at two
+        // points (λ points), and ground contacts: branched
+        let m = ContactMaterial::hertz(1e8);
+        let at = |a, b| Contact::new([Some(a), b], [0.0, 0.0], [1.0, 0.0], m);
+        let star: Vec<Contact> = [1, 2, 3]
+            .iter()
+            .flat_map(|&k| [at(0, Some(k)), at(0, Some(k)), at(k, None)])
+            .collect();
+        assert!(branches(&star, &mut pairs));
+        // two of them: a chain again, however many points a pair has
+        assert!(!branches(&star[..6], &mut pairs));
+    }
+
+    /// A Newton's cradle of many balls is a chain, not a large group: under
+    /// the default budget it ends by the law however long it is (the
+    /// 12-ball cradle with e = 0.9 needs 3,300 work units, past the large
+    /// groups' cap), with momentum kept and the energy of e < 1.
+    #[test]
+    fn a_long_cradle_keeps_the_law_under_the_budget() {
+        let settings = ImpactSettings::adaptive(1e-6);
+        let mut solver = GroupSolver::default();
+        let mut out = ImpactOutcome::default();
+        for n in [12, 20] {
+            let (bodies, contacts) = cradle(n, 0.9);
+            let how = solver
+                .solve_into(&bodies, &contacts, &settings, &budgeted(), &mut out)
+                .unwrap();
+            assert_eq!(how, Resolution::Lzb, "{n} balls");
+            assert!(!solver.last_was_large());
+            assert!(solver.last_work() > LargeGroup::DEFAULT.work, "{n} balls");
+            let (p0, p1) = (momentum(&bodies, None), momentum(&bodies, Some(&out)));
+            assert!((p1[0] - p0[0]).abs() < 1e-12, "{p1:?}");
+            // some energy lost (e < 1), none created; a plastic cradle
+            // would keep only 1/n of it
+            let ke0: f64 = bodies.iter().map(Body::kinetic_energy).sum();
+            assert!(out.kinetic_energy_after < ke0);
+            assert!(out.kinetic_energy_after > 2.0 / n as f64 * ke0, "{n} balls");
+        }
+    }
+
+    #[test]
+    fn small_groups_and_chains_keep_the_law() {
         let settings = ImpactSettings::adaptive(1e-6);
         let mut solver = GroupSolver::default();
         let (mut a, mut b) = (ImpactOutcome::default(), ImpactOutcome::default());

@@ -73,6 +73,10 @@ pub struct ImpactReport {
     pub steps: usize,
     /// How the impact was resolved (the fallback policy's stage).
     pub resolution: Resolution,
+    /// A large group under a work budget, its LZB attempts capped
+    /// ([`super::FallbackPolicy::large_group`]): a pile rather than a chain
+    /// or a row's front.
+    pub large_group: bool,
 }
 
 /// One contact of a resolved group, with the impulse it carried: what a game
@@ -552,6 +556,7 @@ impl ImpactGroups {
                 out.steps
             },
             resolution,
+            large_group: self.solver.last_was_large(),
         });
     }
 }

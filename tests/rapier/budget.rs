@@ -100,9 +100,10 @@ fn large_groups_of_a_pile_end_plastic_within_their_cap() {
     let (mut capped, mut lzb) = (0, 0);
     for _ in 0..(2.0 / sw.world.integration_parameters.dt).round() as usize {
         for r in sw.step() {
-            if r.bodies <= large.bodies {
+            if !r.large_group {
                 continue;
             }
+            assert!(r.bodies > large.bodies, "{r:?}");
             match r.resolution {
                 Resolution::Lzb => {
                     let c = r.contacts as u64;
