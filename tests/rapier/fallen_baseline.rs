@@ -113,8 +113,9 @@ fn a_drop_native_rapier_does_not_match_is_counted() {
 /// blocks, μ1 0.48, μ2 0.27, e1 0.6, e2 0.2, Rapier f32 at Δt = 1/60 s):
 /// the last block slides out flat ahead of the row, and the blocks behind
 /// it rock back by about 20° in every Rapier engine at this step; in
-/// topple's f32 build blocks 17 and 18 end below π/4 (docs/stress.md, "A
-/// fallen count native Rapier rocks back as far"). The paper's model, run
+/// topple's f32 build blocks 17 and 18 ended below π/4 (docs/stress.md, "A
+/// fallen count native Rapier rocks back as far") until the rebound
+/// threshold came down to one Rapier step's approach. The paper's model, run
 /// past the last hit by the reference engine ([`model_rock_back`]), settles
 /// the train back by well under a degree, so the rest is the coarse step's
 /// error: Rapier's step is first order, so topple's rock-back in excess of
@@ -131,19 +132,26 @@ fn combo_222_rocks_back_as_far_as_native_rapier_and_less_at_finer_steps() {
     let c = draw(1, 222, spec.n_lo, spec.n_hi);
     assert_eq!(c.engine, StressEngine::RapierF32);
     let o = run_combo(&c, 120.0);
-    let r = o.native_rock_back.expect("native run beside the drop");
-    println!(
-        "Δt: drop {} (blocks {:?}, {:.2}°); from nearby starts topple ≥ {:.2}°, native ≤ {:.2}° (drops ≤ {})",
-        o.fallen_drop,
-        o.stood_up,
-        o.stood_up_rock_back.to_degrees(),
-        r.topple_least.to_degrees(),
-        r.native_most.to_degrees(),
-        r.native_drop
-    );
     assert!(violations(&c, &o).is_empty());
-    // a rock-back of Rapier's at 1/60 s: far beyond the model's
-    assert!(r.native_most.to_degrees() > 10.0);
+    // Native Rapier is run beside a drop only. Since the rebound threshold
+    // is one Rapier step's approach (docs/game-rate.md, "The rebound
+    // threshold at one Rapier step's approach") the drawn start stands no
+    // block back up at Δt, as in the model, and the rule has nothing to
+    // hold against native there; the steps below still judge the rock-back.
+    if o.fallen_drop > 0 {
+        let r = o.native_rock_back.expect("native run beside the drop");
+        println!(
+            "Δt: drop {} (blocks {:?}, {:.2}°); from nearby starts topple ≥ {:.2}°, native ≤ {:.2}° (drops ≤ {})",
+            o.fallen_drop,
+            o.stood_up,
+            o.stood_up_rock_back.to_degrees(),
+            r.topple_least.to_degrees(),
+            r.native_most.to_degrees(),
+            r.native_drop
+        );
+        // a rock-back of Rapier's at 1/60 s: far beyond the model's
+        assert!(r.native_most.to_degrees() > 10.0);
+    }
     let model = model_rock_back(&c);
     println!("the model's settle-back: {:.3}°", model.to_degrees());
     let mut last = f64::INFINITY;
