@@ -241,12 +241,8 @@ pub(super) struct PointState {
     pub(super) open: bool,
     /// The compression at which the onset of an open point is a switch:
     /// 0 for a gap, the rounding of zero (`Row::q_zero`) for a point that
-    /// starts the step within it (|q| ≤ q_zero), where it does not carry
-    /// load yet (modes.rs, `carries_load`) (m). A gap within the rounding
-    /// (a resting point that rounding moved apart, its rate itself
-    /// rounding) closes where q leaves the rounding, not where it crosses
-    /// zero: each such crossing was a step cut short for nothing
-    /// (docs/impact.md, "Steps per impact, round eleven").
+    /// starts the step within it, where it does not carry load yet
+    /// (modes.rs, `carries_load`) (m).
     pub(super) close_at: f64,
     /// An e = 0 point whose energy has just been lost after a load cycle
     /// short enough to be held closed from now on (see

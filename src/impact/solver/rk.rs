@@ -48,7 +48,7 @@ impl Integrator {
             let open = self.points[i].mode == PointMode::Compress
                 && (q0 < 0.0 || (q0 <= q_zero && self.onset_due(i, &rk.y0, now)));
             self.points[i].open = open;
-            self.points[i].close_at = if q0 >= -q_zero { q_zero } else { 0.0 };
+            self.points[i].close_at = if q0 > 0.0 { q_zero } else { 0.0 };
         }
         if !rk.fresh {
             let (y0, k) = (&rk.y0, &mut rk.k[0]);
