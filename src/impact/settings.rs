@@ -99,8 +99,12 @@ pub struct ImpactSettings {
     /// of the cycle's swing W_ii ΔP (docs/model.md §8). e > 0 contacts that
     /// bounce again and again inside a pile are held the same way after a
     /// cycle within 0.03 of this bound, their small approach stopped as
-    /// by a plastic impact (§8, "Fast bounces at e > 0"). 0: every cycle is
-    /// followed (the paper's law to the integration tolerance).
+    /// by a plastic impact (§8, "Fast bounces at e > 0"). With a
+    /// [`rest_speed`](Self::rest_speed) v_r the e = 0 bound is at least
+    /// 30 v_r (0.3 of the plugins' impact threshold at their rest
+    /// fraction): a cycle that slow is left to its limit as the slow tail
+    /// is left to the engine (§8). 0: every cycle is followed (the paper's
+    /// law to the integration tolerance), whatever the rest speed.
     #[serde(default = "default_fast_cycle")]
     pub fast_cycle: f64,
     /// The speed (m/s, or the world's length unit per second) below which

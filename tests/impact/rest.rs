@@ -275,3 +275,42 @@ fn a_settling_that_cycles_ends_and_the_law_resolves_the_impact() {
     assert!(audit.energy_gain <= 1e-9, "{audit:?}");
     assert!(audit.consistency < 1e-9, "{audit:?}");
 }
+
+/// With a rest speed v_r the e = 0 release–reload cycles are taken by
+/// their limit once a cycle moves the point's rate by at most 30 v_r
+/// (docs/model.md §8, "With a rest speed"). On the captured impacts of an
+/// ideal Domino T row at 1/60 s (the bench's `t-row`, the plugins'
+/// settings: tolerance 10⁻⁶, v_r = 0.01 · 2|g|Δt) each outcome stays
+/// within the rest speed's own tail, 3 v_r (§9), of the paper's law
+/// converged (every cycle followed, tolerance 10⁻¹⁰, no rest speed); no
+/// energy is created and the velocities follow from the impulses.
+#[test]
+fn e0_cycles_slower_than_the_rest_speeds_are_held_within_its_tail_of_the_law() {
+    let rest = 0.01 * 2.0 * 9.81 / 60.0;
+    let plugin = ImpactSettings {
+        rest_speed: rest,
+        ..ImpactSettings::adaptive(1e-6)
+    };
+    let law = ImpactSettings {
+        fast_cycle: 0.0,
+        max_steps: 1_000_000,
+        ..ImpactSettings::adaptive(1e-10)
+    };
+    let text = include_str!("../../benches/data/t-row-1-60.jsonl");
+    let mut solver = ImpactSolver::new();
+    let mut impacts = 0;
+    for line in text.lines().filter(|l| !l.trim().is_empty()) {
+        let c: topple::impact::capture::CapturedImpact = serde_json::from_str(line).unwrap();
+        let (bodies, contacts) = (c.bodies, c.contacts);
+        let converged = solver.solve(&bodies, &contacts, &law).unwrap();
+        let out = solver.solve(&bodies, &contacts, &plugin).unwrap();
+        let off = difference(&bodies, &out, &converged);
+        assert!(off < 3.0 * rest, "{off:.2e} m/s against v_r = {rest:.2e}");
+        let mut audit = AuditSummary::default();
+        check(&bodies, &contacts, &out, &mut audit);
+        assert!(audit.consistency < 1e-9, "{audit:?}");
+        assert!(audit.energy_gain <= 0.0, "{audit:?}");
+        impacts += 1;
+    }
+    assert_eq!(impacts, 6);
+}

@@ -239,7 +239,7 @@ impl Integrator {
                     let swing = row.w_nn * (impulse - point.cycle_start);
                     point.cycle_start = impulse;
                     self.y[lay.q(i)] = 0.0;
-                    point.released = swing <= self.fast_cycle * self.scales.velocity;
+                    point.released = swing <= self.cycle_bound;
                 }
             }
             Switch::Recompresses(i) => self.points[i].mode = PointMode::Compress,
