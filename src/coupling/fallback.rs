@@ -332,6 +332,7 @@ impl GroupSolver {
                 return result.map(|()| Resolution::Held);
             }
         }
+        self.plastic.set_rest_speed(settings.rest_speed);
         self.plastic.solve_into(bodies, contacts, out);
         Ok(Resolution::Plastic)
     }

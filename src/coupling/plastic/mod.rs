@@ -98,6 +98,10 @@ pub struct PlasticSolver {
     speed: f64,
     scale: f64,
     direct: direct::Direct,
+    /// Sweeps also stop once no contact approaches faster than this (m/s;
+    /// 0: only the impulse tolerance ends them). See
+    /// [`PlasticSolver::set_rest_speed`].
+    rest_speed: f64,
 }
 
 impl PlasticSolver {
@@ -106,6 +110,44 @@ impl PlasticSolver {
     pub const TOLERANCE: f64 = 1e-12;
     /// Sweeps at most.
     pub const MAX_SWEEPS: usize = 1_000;
+    /// With a rest speed set, the sweeps test the approach speeds once in
+    /// this many sweeps (a test costs about half a sweep).
+    const REST_TEST_EVERY: usize = 4;
+
+    /// Ends the sweeps, as the LZB resolver ends an impact
+    /// ([`crate::impact::ImpactSettings::rest_speed`], docs/model.md §9), as
+    /// soon as no contact approaches faster than `speed` (m/s; 0, the
+    /// default, sweeps to [`Self::TOLERANCE`]). The direct stage is then not
+    /// needed. The fallback policy passes the impact's rest speed.
+    ///
+    /// ```
+    /// use topple::coupling::PlasticSolver;
+    /// use topple::impact::{Body, Contact, ContactMaterial, ImpactOutcome};
+    /// // a light box (0.1 kg) between the ground and a heavy one (10 kg)
+    /// // falling at 1 m/s: both stop, to the rest speed
+    /// let bodies = [
+    ///     Body::new(0.1, 1e-3).with_position([0.0, 0.05]),
+    ///     Body::new(10.0, 0.1).with_position([0.0, 0.15]).with_velocity([0.0, -1.0]),
+    /// ];
+    /// let m = ContactMaterial::hertz(1e8);
+    /// let contacts = [
+    ///     Contact::new([None, Some(0)], [0.0, 0.0], [0.0, 1.0], m),
+    ///     Contact::new([Some(0), Some(1)], [0.0, 0.1], [0.0, 1.0], m),
+    /// ];
+    /// let mut solver = PlasticSolver::default();
+    /// solver.set_rest_speed(1e-3);
+    /// let mut out = ImpactOutcome::default();
+    /// solver.solve_into(&bodies, &contacts, &mut out);
+    /// assert!(out.bodies[1].velocity[1].abs() <= 1e-3);
+    /// assert!(out.bodies[0].velocity[1].abs() <= 1e-3);
+    /// ```
+    pub fn set_rest_speed(&mut self, speed: f64) {
+        self.rest_speed = if speed.is_finite() {
+            speed.max(0.0)
+        } else {
+            0.0
+        };
+    }
 
     /// Resolves the impact of `bodies` at `contacts` as plastic into `out`
     /// (velocities, impulses, kinetic energy before and after; `steps` counts
@@ -160,6 +202,12 @@ impl PlasticSolver {
         while sweeps < cap {
             sweeps += 1;
             if self.sweep() <= Self::TOLERANCE * self.scale {
+                return (sweeps, true);
+            }
+            if self.rest_speed > 0.0
+                && sweeps % Self::REST_TEST_EVERY == 0
+                && self.worst_approach() <= self.rest_speed
+            {
                 return (sweeps, true);
             }
         }
@@ -534,6 +582,42 @@ pub(super) mod tests {
                 assert!(pt.abs() <= r.stick_friction * pn * (1.0 + 1e-12) + 1e-15);
             }
         }
+    }
+
+    /// With a rest speed (the fallback policy passes the impact's), the
+    /// sweeps end once no contact approaches faster than it: on random
+    /// stacks with friction no contact is left approaching faster, no
+    /// energy is created, the cone holds, and the sweeps and direct solves
+    /// together cost less than solving to the impulse tolerance.
+    #[test]
+    fn random_stacks_end_at_the_rest_speed_for_less_work() {
+        let (mut draw, mut solver) = (xorshift(), PlasticSolver::default());
+        let mut out = ImpactOutcome::default();
+        let (mut exact, mut rested) = (0, 0);
+        for _ in 0..1000 {
+            let (bodies, contacts) = random_stack(&mut draw, true);
+            let speed = bodies
+                .iter()
+                .map(|b| b.velocity[1].abs())
+                .fold(0.0, f64::max);
+            solver.set_rest_speed(0.0);
+            solver.solve_into(&bodies, &contacts, &mut out);
+            exact += out.steps;
+            let rest = 1e-3 * speed;
+            solver.set_rest_speed(rest);
+            solver.solve_into(&bodies, &contacts, &mut out);
+            rested += out.steps;
+            assert!(!out.gains_energy());
+            assert!(
+                solver.worst_approach() <= rest,
+                "{}",
+                solver.worst_approach()
+            );
+            for (r, &[pn, pt]) in solver.rows.iter().zip(&solver.impulse) {
+                assert!(pt.abs() <= r.stick_friction * pn * (1.0 + 1e-12) + 1e-15);
+            }
+        }
+        assert!(rested < exact, "{rested} ≥ {exact}");
     }
 
     /// A wedged group (a ball pressed between two walls and pushed by a
