@@ -205,7 +205,7 @@ impl PlasticSolver {
                 return (sweeps, true);
             }
             if self.rest_speed > 0.0
-                && sweeps % Self::REST_TEST_EVERY == 0
+                && sweeps.is_multiple_of(Self::REST_TEST_EVERY)
                 && self.worst_approach() <= self.rest_speed
             {
                 return (sweeps, true);
