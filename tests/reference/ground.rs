@@ -4,6 +4,7 @@
 //! cooperative-model oracle (tests/common/cooperative.rs).
 
 use crate::common::cooperative::cooperative_speed;
+use crate::natural_speeds;
 use topple::domino::{Ground, Preset, RowSpec};
 use topple::impact::{resolve, Body, Contact, ContactMaterial, ImpactSettings};
 use topple::reference::{run, Settings};
@@ -186,12 +187,7 @@ fn default_freeze_against_converged(ground: Ground, sh: f64) {
     let mut p = Preset::T.params().ideal();
     p.ground = ground;
     let row = RowSpec::new(p, sh * p.block.height, 30, 1.0);
-    let fast = run(&row, &Settings::default()).unwrap().report;
-    let reference = run(&row, &converged).unwrap().report;
-    let (a, b) = (
-        fast.natural_speed.unwrap(),
-        reference.natural_speed.unwrap(),
-    );
+    let (a, b, _) = natural_speeds(&row, &Settings::default(), &converged);
     println!("{ground:?} s/h {sh}: default {a:.5}, converged {b:.5}");
     assert!(
         (a - b).abs() < 5e-3 * b,
