@@ -725,6 +725,51 @@ pub(super) mod tests {
         assert!(rested < exact, "{rested} ≥ {exact}");
     }
 
+    /// A plastic solve of the pile scene (33 boxes, 66 contact points, wood
+    /// with μ = 0.5 and μ_s = 0.6; captured from `topple scene
+    /// assets/scenes/pile-boxes.toml`), too large for the direct stage, on
+    /// which the sweeps under the stick–slip rule cycle: after
+    /// [`PlasticSolver::MAX_SWEEPS`] a contact still approaches faster than
+    /// twice the impact's rest speed. The solve notices the stall and goes
+    /// on with one coefficient μ_s: it ends with
+    /// no contact approaching faster than the rest speed, no energy
+    /// created, every tangential impulse within μ_s P_n, and fewer sweeps
+    /// than the cap.
+    #[test]
+    fn sweeps_that_cycle_end_at_the_rest_speed_with_one_coefficient() {
+        let input: serde_json::Value =
+            serde_json::from_str(include_str!("../../../tests/data/pile-plastic-cycle.json"))
+                .expect("the captured solve");
+        let bodies: Vec<Body> = serde_json::from_value(input["bodies"].clone()).expect("bodies");
+        let contacts: Vec<Contact> =
+            serde_json::from_value(input["contacts"].clone()).expect("contacts");
+        let rest = input["rest_speed"].as_f64().expect("rest speed");
+        let mut solver = PlasticSolver::default();
+        solver.set_rest_speed(rest);
+        // the two-coefficient sweeps alone, to the cap
+        solver.load(&bodies, &contacts);
+        let (_, end) = solver.iterate(0, PlasticSolver::MAX_SWEEPS, false);
+        assert_eq!(end, Sweeps::Capped);
+        assert!(
+            solver.worst_approach() > 2.0 * rest,
+            "{}",
+            solver.worst_approach()
+        );
+        let mut out = ImpactOutcome::default();
+        solver.solve_into(&bodies, &contacts, &mut out);
+        assert!(
+            solver.worst_approach() <= rest,
+            "{} > {rest}",
+            solver.worst_approach()
+        );
+        assert!(!out.gains_energy());
+        for (r, &[pn, pt]) in solver.rows.iter().zip(&solver.impulse) {
+            assert!(pn >= 0.0);
+            assert!(pt.abs() <= r.stick_friction * pn * (1.0 + 1e-12) + 1e-15);
+        }
+        assert!(out.steps < PlasticSolver::MAX_SWEEPS, "{}", out.steps);
+    }
+
     /// A wedged group (a ball pressed between two walls and pushed by a
     /// second ball) never gains energy, and no contact approaches afterwards.
     #[test]
