@@ -314,9 +314,26 @@ impl PlasticSolver {
     /// for 21.0·10⁶ such entries (4.15 an entry), a sweep 249 a contact,
     /// so a contact's sweep is worth 60 entries.
     pub(super) fn direct_work(&self, pivots: usize) -> usize {
-        const ENTRIES_PER_CONTACT_SWEEP: usize = 60;
         let n = self.direct.normal.len() + 3 * self.direct.friction.len();
+        self.direct_work_of(n, pivots)
+    }
+
+    /// [`Self::direct_work`] of a problem of `n` unknowns solved in
+    /// `pivots` pivots.
+    pub(super) fn direct_work_of(&self, n: usize, pivots: usize) -> usize {
+        const ENTRIES_PER_CONTACT_SWEEP: usize = 60;
         let entries = pivots * n * (2 * n + 2) + 10 * n * n;
         entries.div_ceil(ENTRIES_PER_CONTACT_SWEEP * self.rows.len().max(1))
+    }
+
+    /// The rows the direct stage would solve for: those whose bodies can
+    /// move, and how many of them have friction.
+    pub(super) fn direct_unknowns(&self) -> (usize, usize) {
+        self.rows
+            .iter()
+            .filter(|r| r.inv_w_nn > 0.0)
+            .fold((0, 0), |(n, f), r| {
+                (n + 1, f + usize::from(r.friction > 0.0))
+            })
     }
 }
