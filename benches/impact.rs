@@ -341,7 +341,9 @@ fn measure(class: &Class, solver: &mut ImpactSolver, s: &ImpactSettings) -> Meas
 }
 
 /// A profiling run (`IMPACT_PROFILE=class`): the class's impacts
-/// at the plugins' default, `IMPACT_REPEAT` times (1 unless set), without
+/// at the plugins' default (or at `IMPACT_TOLERANCE` and
+/// `IMPACT_REST_FRACTION` of the impact threshold at 1/60 s, when set),
+/// `IMPACT_REPEAT` times (1 unless set), without
 /// the converged runs, the table or criterion, so that `valgrind
 /// --tool=callgrind` on the bench binary counts the resolver alone (the
 /// leaning trains, `leaning20` and `domino20`, are built rather than
@@ -373,10 +375,17 @@ fn profile(name: &str) {
         .ok()
         .and_then(|r| r.parse().ok())
         .unwrap_or(1);
+    let var = |name: &str| std::env::var(name).ok().and_then(|v| v.parse::<f64>().ok());
+    let fraction = var("IMPACT_REST_FRACTION")
+        .unwrap_or(topple::coupling::ToppleSettings::DEFAULT_REST_FRACTION);
+    let base = var("IMPACT_TOLERANCE").map_or(
+        topple::coupling::ToppleSettings::default().impact,
+        ImpactSettings::adaptive,
+    );
     let s = ImpactSettings {
-        rest_speed: topple::coupling::ToppleSettings::DEFAULT_REST_FRACTION * THRESHOLD_1_60,
+        rest_speed: fraction * THRESHOLD_1_60,
         max_steps: 1_000_000,
-        ..topple::coupling::ToppleSettings::default().impact
+        ..base
     };
     let mut solver = ImpactSolver::new();
     let mut steps = 0;
