@@ -107,7 +107,9 @@ fn chain10() -> Class {
     }
 }
 
-fn leaning(elastic: bool) -> Class {
+/// The leaning train's bodies and contacts (e = 1 without friction, or the
+/// domino's e = 0 with friction).
+fn leaning_group(elastic: bool) -> (Vec<Body>, Vec<Contact>) {
     let (between, ground) = if elastic {
         (ContactMaterial::hertz(2.3e8), ContactMaterial::hertz(6.9e8))
     } else {
@@ -129,7 +131,11 @@ fn leaning(elastic: bool) -> Class {
         between,
         ground,
     };
-    let (bodies, contacts) = group.build();
+    group.build()
+}
+
+fn leaning(elastic: bool) -> Class {
+    let (bodies, contacts) = leaning_group(elastic);
     if elastic {
         let reference = compliant::integrate(&bodies, &contacts, 400.0);
         Class {
@@ -334,7 +340,73 @@ fn measure(class: &Class, solver: &mut ImpactSolver, s: &ImpactSettings) -> Meas
     }
 }
 
+/// A profiling run (`IMPACT_PROFILE=class`): the class's impacts
+/// at the plugins' default (or at `IMPACT_TOLERANCE` and
+/// `IMPACT_REST_FRACTION` of the impact threshold at 1/60 s, when set),
+/// `IMPACT_REPEAT` times (1 unless set), without
+/// the converged runs, the table or criterion, so that `valgrind
+/// --tool=callgrind` on the bench binary counts the resolver alone (the
+/// leaning trains, `leaning20` and `domino20`, are built rather than
+/// read). Prints the class's accepted steps.
+fn profile(name: &str) {
+    let file = match name {
+        "leaning20" | "domino20" => "",
+        "x-row" => "x-row-1-60.jsonl",
+        "t-row" => "t-row-1-60.jsonl",
+        "box-on-stack" => "box-on-stack.jsonl",
+        "pile" => "pile.jsonl",
+        "cradle-5" => "cradle-5.jsonl",
+        _ => panic!("IMPACT_PROFILE: no class {name}"),
+    };
+    let impacts: Vec<(Vec<Body>, Vec<Contact>)> = if file.is_empty() {
+        vec![leaning_group(name == "leaning20")]
+    } else {
+        let path = format!("{}/benches/data/{file}", env!("CARGO_MANIFEST_DIR"));
+        let text = std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("{path}: {e}"));
+        text.lines()
+            .filter(|l| !l.trim().is_empty())
+            .map(|l| {
+                let c: CapturedImpact = serde_json::from_str(l).unwrap();
+                (c.bodies, c.contacts)
+            })
+            .collect()
+    };
+    let repeat: usize = std::env::var("IMPACT_REPEAT")
+        .ok()
+        .and_then(|r| r.parse().ok())
+        .unwrap_or(1);
+    let var = |name: &str| std::env::var(name).ok().and_then(|v| v.parse::<f64>().ok());
+    let fraction = var("IMPACT_REST_FRACTION")
+        .unwrap_or(topple::coupling::ToppleSettings::DEFAULT_REST_FRACTION);
+    let base = var("IMPACT_TOLERANCE").map_or(
+        topple::coupling::ToppleSettings::default().impact,
+        ImpactSettings::adaptive,
+    );
+    let s = ImpactSettings {
+        rest_speed: fraction * THRESHOLD_1_60,
+        max_steps: 1_000_000,
+        ..base
+    };
+    let mut solver = ImpactSolver::new();
+    let mut steps = 0;
+    for _ in 0..repeat {
+        for (bodies, contacts) in &impacts {
+            if let Ok(out) = solver.solve(bodies, contacts, &s) {
+                steps += out.steps;
+            }
+        }
+    }
+    println!(
+        "{name}: {} impacts x {repeat}, {steps} steps",
+        impacts.len()
+    );
+}
+
 fn bench(c: &mut Criterion) {
+    if let Ok(name) = std::env::var("IMPACT_PROFILE") {
+        profile(&name);
+        return;
+    }
     let classes = [
         chain10(),
         leaning(true),

@@ -48,7 +48,11 @@ impl Integrator {
             let open = self.points[i].mode == PointMode::Compress
                 && (q0 < 0.0 || (q0 <= q_zero && self.onset_due(i, &rk.y0, now)));
             self.points[i].open = open;
-            self.points[i].close_at = if q0 > 0.0 { q_zero } else { 0.0 };
+            // a gap closed at this instant with an earlier switch was set
+            // to q = 0 (events.rs, `close_with`): as a landed closing, it
+            // closes again only once q leaves the rounding
+            let closed_now = self.points[i].closed_at == now;
+            self.points[i].close_at = if q0 > 0.0 || closed_now { q_zero } else { 0.0 };
         }
         if !rk.fresh {
             let (y0, k) = (&rk.y0, &mut rk.k[0]);
