@@ -97,6 +97,9 @@ pub struct ToppleFrameStats {
     /// got Rapier's own response this frame (colliders topple leaves to
     /// Rapier, or after the budget ran out).
     pub native_impacts: u64,
+    /// Impacts solved side by side with others of the same physics step
+    /// this frame (docs/bevy.md, "Independent impacts side by side").
+    pub batched_impacts: u64,
     /// Wall time of topple's own work this frame, Rapier excluded (s).
     pub topple_seconds: f64,
     /// Wall time of the whole physics step this frame, Rapier included (s).

@@ -151,6 +151,8 @@ pub struct ImpactGroups {
     /// Work of the LZB attempts of the last call, all groups together
     /// ([`super::FallbackPolicy::max_work`]).
     work: u64,
+    /// Work of each group of the last call.
+    group_work: Vec<u64>,
 }
 
 #[inline]
@@ -186,6 +188,16 @@ pub fn seed_approach(bodies: &[Body], c: &PointContact, settings: &ToppleSetting
     (vn < -settings.min_approach_speed && (free(c.bodies[0]) || free(c.bodies[1]))).then_some(-vn)
 }
 
+/// Whether a first LZB attempt that charged `work` on an impact of
+/// `contacts` points takes the same steps under the budget `left`
+/// ([`ImpactGroups::same_under`]): `floor(left/points) ≥ s + 1 + margin`,
+/// `s = work/points`, the margin as the fallback policy keeps it back.
+fn lzb_fits(work: u64, contacts: usize, left: u64) -> bool {
+    let points = contacts.max(1) as u64;
+    let margin = 2 + 2 * (4 + 4 * contacts as u64) / 6;
+    left / points >= work / points + 1 + margin
+}
+
 fn find(parent: &mut [usize], mut i: usize) -> usize {
     while parent[i] != i {
         parent[i] = parent[parent[i]];
@@ -211,6 +223,70 @@ impl ImpactGroups {
     /// impact's contact points ([`super::FallbackPolicy::max_work`]).
     pub fn work(&self) -> u64 {
         self.work
+    }
+
+    /// Whether the last [`ImpactGroups::resolve`], called with the work
+    /// budget `given` ([`super::FallbackPolicy::max_work`]), gave the same
+    /// result as a call with the smaller budget `budget` would have: then
+    /// the impacts of a step that were solved side by side, each with the
+    /// budget left at the start, keep the budget's sequential meaning
+    /// without being solved again.
+    ///
+    /// Sufficient, not necessary: the budgets are equal, or every group
+    /// finished by the law's first attempt ([`Resolution::Lzb`]) with room
+    /// to spare under `budget`. The reason is in the fallback policy's
+    /// code ([`super::GroupSolver`]): the budget enters an attempt only as
+    /// its step limit, `floor(left / points) − margin` steps (the margin
+    /// covers the step and two settlings an attempt may take past its
+    /// limit, `2 + 2·(4 + 4·points)/6`), and the resolvers compare their
+    /// step counters with that limit and use it for nothing else (the
+    /// time-domain resolver's `attempts + settling/6 > limit`, the impulse
+    /// resolvers' `attempts > limit` and `steps ≥ limit`). A first attempt
+    /// that finished with `s` steps charged (work `s·points`, every counter
+    /// it checked at most `s + 1`) takes the same steps under any limit of
+    /// at least `s + 1`, so any budget with `floor(budget/points) ≥ s + 1 +
+    /// margin` gives the same bits. The groups of one call share the
+    /// budget, each checked with what the groups before it left.
+    ///
+    /// ```
+    /// use topple::impact::{Body, ContactMaterial};
+    /// use topple::coupling::{ImpactGroups, PointContact, ToppleSettings};
+    /// let mut bodies = [
+    ///     Body::new(1.0, 0.004).with_velocity([1.0, 0.0]),
+    ///     Body::new(1.0, 0.004).with_position([0.2, 0.0]),
+    /// ];
+    /// let contacts = [PointContact {
+    ///     bodies: [Some(0), Some(1)], point: [0.1, 0.0], normal: [1.0, 0.0], dist: 0.0,
+    ///     material: ContactMaterial::hertz(1e8), persistent: false,
+    /// }];
+    /// let mut settings = ToppleSettings::default();
+    /// settings.fallback.max_work = Some(50_000);
+    /// let mut groups = ImpactGroups::default();
+    /// groups.resolve(&mut bodies, &contacts, &settings);
+    /// let work = groups.work();
+    /// assert!(groups.same_under(Some(50_000), Some(50_000)));
+    /// assert!(groups.same_under(Some(50_000), Some(work + 100)));
+    /// assert!(!groups.same_under(Some(50_000), Some(work)));
+    /// ```
+    pub fn same_under(&self, given: Option<u64>, budget: Option<u64>) -> bool {
+        if given == budget {
+            return true;
+        }
+        let (Some(given), Some(budget)) = (given, budget) else {
+            return false; // a budget and none: the limits differ
+        };
+        let mut spent = 0u64;
+        for (report, &work) in self.reports.iter().zip(&self.group_work) {
+            let left = budget.saturating_sub(spent);
+            if given.saturating_sub(spent) == left {
+                return true; // the rest sees the same budget
+            }
+            if report.resolution != Resolution::Lzb || !lzb_fits(work, report.contacts, left) {
+                return false;
+            }
+            spent += work;
+        }
+        true
     }
 
     /// The free bodies of group `g` of the last call (indices into the body
@@ -243,6 +319,7 @@ impl ImpactGroups {
         self.contact_start.push(0);
         self.body_order.clear();
         self.work = 0;
+        self.group_work.clear();
         self.find_seeds(bodies, contacts, settings);
         if self.seeds.is_empty() {
             return 0; // the common case: nothing else is done
@@ -513,6 +590,7 @@ impl ImpactGroups {
             &mut self.outcome,
         );
         self.work += self.solver.last_work();
+        self.group_work.push(self.solver.last_work());
         let resolution = result.unwrap_or(Resolution::Rejected);
         let out = &self.outcome;
         let members = &self.body_order[self.body_start[g]..self.body_start[g + 1]];
