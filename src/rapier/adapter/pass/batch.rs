@@ -61,7 +61,7 @@ pub(super) struct Item {
     t: f64,
     /// The lowest threshold of its closing pairs.
     threshold: f64,
-    groups: ImpactGroups,
+    pub(super) groups: ImpactGroups,
     /// The group's bodies: their velocities before the solve in `start`,
     /// after it in `bodies`.
     bodies: Vec<Body>,
@@ -104,7 +104,24 @@ impl ImpactPass {
     ) -> (usize, usize) {
         let n = self.build_batch(world, hooks, settings, t, max);
         self.solve_batch(n, settings);
-        self.apply_batch(world, hooks, settings, n, offset)
+        let done = self.apply_batch(world, hooks, settings, n, offset);
+        self.return_buffers(n);
+        done
+    }
+
+    /// Gives the pass back the buffers its builds handed to the first `n`
+    /// items (each build swapped the pass's for the item's, a rotation):
+    /// every buffer stays with its owner from batch to batch, so each one
+    /// grows to what its owner needs once and a steady scene allocates
+    /// nothing.
+    fn return_buffers(&mut self, n: usize) {
+        for item in self.items[..n].iter_mut().rev() {
+            std::mem::swap(&mut item.bodies, &mut self.bodies);
+            std::mem::swap(&mut item.handles, &mut self.handles);
+            std::mem::swap(&mut item.contacts, &mut self.contacts);
+            std::mem::swap(&mut item.seeds, &mut self.seeds);
+            std::mem::swap(&mut item.fresh, &mut self.fresh);
+        }
     }
 
     /// Builds the items of a batch from instant `t` on; returns how many.
@@ -259,12 +276,13 @@ impl ImpactPass {
                 break;
             }
         }
-        // the last group applied stays the grouping stage's (`groups()`)
-        self.swap_item(applied - 1);
+        // the last groups applied are the grouping stage's (`groups()`)
+        self.last_item = Some(applied - 1);
         (applied, groups)
     }
 
-    /// Exchanges item `j`'s groups, bodies and handles with the pass's.
+    /// Exchanges item `j`'s groups, bodies and handles with the pass's
+    /// (done twice around applying it: each keeps its own).
     fn swap_item(&mut self, j: usize) {
         let item = &mut self.items[j];
         std::mem::swap(&mut item.groups, &mut self.groups);

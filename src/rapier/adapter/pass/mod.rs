@@ -171,6 +171,9 @@ pub(crate) struct ImpactPass {
     reached: Vec<(u64, usize)>,
     /// The current batch's stamp.
     stamp: u64,
+    /// The batch item whose groups were applied last (`None`: the pass's
+    /// own, resolved one instant at a time).
+    last_item: Option<usize>,
 }
 
 const NO_SLOT: u32 = u32::MAX;
@@ -217,7 +220,10 @@ fn dynamic_parent(world: &World, co: &Collider) -> Option<RigidBodyHandle> {
 impl ImpactPass {
     /// The grouping stage.
     pub fn groups(&self) -> &ImpactGroups {
-        &self.groups
+        match self.last_item {
+            Some(j) => &self.items[j].groups,
+            None => &self.groups,
+        }
     }
 
     /// Forgets the impacts of the last step (a step may run several passes
@@ -267,6 +273,7 @@ impl ImpactPass {
         while events < MAX_EVENTS {
             let Some(t) = self.earliest() else { break };
             if self.one_at_a_time {
+                self.last_item = None;
                 groups += self.resolve_at(world, hooks, settings, t, offset);
                 events += 1;
                 continue;
