@@ -147,6 +147,13 @@ impl ToppleWorld {
         &self.adapter
     }
 
+    /// Whether a physics step's independent impacts are solved in batches,
+    /// side by side, or one instant at a time: the same bits either way
+    /// ([`ToppleRapier::set_impact_batches`]; on by default).
+    pub fn set_impact_batches(&mut self, on: bool) {
+        self.adapter.set_impact_batches(on);
+    }
+
     /// The id of a material, added on first use.
     pub(crate) fn material_id(&mut self, m: PairMaterial) -> MaterialId {
         if let Some((_, id)) = self.materials.iter().find(|(x, _)| *x == m) {
