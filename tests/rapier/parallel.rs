@@ -161,23 +161,32 @@ fn far_apart_rows_give_the_same_bits_in_batches_without_a_budget() {
     assert_eq!(again, 0, "without a budget nothing is solved again");
 }
 
-/// A budget of a few impacts per step: the sequential order runs it out
-/// part-way through a step's impacts, the later ones end plastic on their
-/// closing pair; batches give the same fallbacks.
+/// Budgets of one to a few impacts per step: the sequential order runs
+/// them out part-way through a step's impacts, the later ones end plastic
+/// on their closing pair, and an impact of a batch may have less left than
+/// it was solved with; batches give the same bits, solving such an impact
+/// again when its result may depend on it.
 #[test]
-fn a_small_budget_gives_the_sequential_fallbacks_in_batches() {
-    let scene = rows(6, WorkBudget::Work(3_000));
-    let (batched, _) = same_bits(&scene, 60);
-    assert!(batched > 0, "no impact was solved in a batch");
-    let mut sw = build(&scene, ImpactResponse::Topple).unwrap();
-    for _ in 0..60 {
-        sw.step();
+fn small_budgets_give_the_sequential_fallbacks_in_batches() {
+    let mut again = 0;
+    for budget in [3_000, 8_000, 20_000] {
+        let scene = rows(6, WorkBudget::Work(budget));
+        let (batched, solved_again) = same_bits(&scene, 60);
+        assert!(batched > 0, "{budget}: no impact was solved in a batch");
+        again += solved_again;
+        let mut sw = build(&scene, ImpactResponse::Topple).unwrap();
+        for _ in 0..60 {
+            sw.step();
+        }
+        let s = sw.topple.stats();
+        assert!(
+            s.plastic_fallbacks + s.held_impacts > 0 && s.budget_spent > 0,
+            "{budget}: the budget never ran out: {s:?}"
+        );
     }
-    let s = sw.topple.stats();
-    assert!(
-        s.plastic_fallbacks + s.held_impacts > 0 && s.budget_spent > 0,
-        "the budget never ran out: {s:?}"
-    );
+    // some impacts of a batch were solved again with the budget the
+    // sequential order left them (`ImpactGroups::same_under`)
+    assert!(again > 0, "no impact was solved again");
 }
 
 #[test]
