@@ -189,6 +189,19 @@ fn small_budgets_give_the_sequential_fallbacks_in_batches() {
     assert!(again > 0, "no impact was solved again");
 }
 
+/// The pile scene (boxes landing on one another, large groups capped and
+/// ending plastic under the default budget): many impacts of a step are
+/// not independent, those that are go in batches; the same bits.
+#[test]
+fn a_pile_gives_the_same_bits_in_batches() {
+    let path =
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/scenes/pile-boxes.toml");
+    let scene = topple::rapier::scene::load_scene(&path).unwrap();
+    let steps = (1.5 / scene.solver.dt).round() as usize;
+    let (batched, _) = same_bits(&scene, steps);
+    assert!(batched > 0, "no impact was solved in a batch");
+}
+
 #[test]
 fn far_apart_cradles_give_the_same_bits_in_batches_and_their_closed_form() {
     let scene = cradles(6);
