@@ -18,7 +18,8 @@
 //! Prints per scene and engine the mean and worst frame (whole `update()`)
 //! and how many frames took longer than 1/60 s, topple's share, topple's
 //! Rapier steps per frame (sub-steps and splits; native takes one), and
-//! what topple did (impacts, fallbacks, steps whose
+//! what topple did (impacts, of them solved side by side with others of
+//! their step, fallbacks, steps whose
 //! work budget ran out, pairs left to Rapier), and per scene whether any
 //! body's state became NaN and how far the lowest body reached below the
 //! ground's top face. A second table gives the CPU time of the process per
@@ -57,6 +58,8 @@ struct Run {
     fallbacks: u64,
     /// Of the fallbacks, large groups (`FallbackPolicy::large_group`).
     large_fallbacks: u64,
+    /// Impacts solved side by side with others of the same physics step.
+    batched: u64,
     budget_spent: u64,
     native_impacts: u64,
     nan: bool,
@@ -77,6 +80,7 @@ fn measure(app: &mut App, frames: usize, ground_y: f32) -> Run {
         impacts: 0,
         fallbacks: 0,
         large_fallbacks: 0,
+        batched: 0,
         budget_spent: 0,
         native_impacts: 0,
         nan: false,
@@ -93,10 +97,11 @@ fn measure(app: &mut App, frames: usize, ground_y: f32) -> Run {
         if std::env::var("FRAMES_VERBOSE").is_ok() {
             let s = app.world().resource::<ToppleFrameStats>();
             eprintln!(
-                "frame {frame}: {ms:.2} ms, topple {:.2} ms, rapier steps {}, impacts {}, fallbacks {} (large {}), work {}, spent {}: {}",
+                "frame {frame}: {ms:.2} ms, topple {:.2} ms, rapier steps {}, impacts {} (batched {}), fallbacks {} (large {}), work {}, spent {}: {}",
                 1e3 * s.topple_seconds,
                 s.rapier_steps,
                 s.impacts,
+                s.batched_impacts,
                 s.fallbacks,
                 s.large_group_fallbacks,
                 s.work,
@@ -112,6 +117,7 @@ fn measure(app: &mut App, frames: usize, ground_y: f32) -> Run {
         run.impacts += s.impacts;
         run.fallbacks += s.fallbacks;
         run.large_fallbacks += s.large_group_fallbacks;
+        run.batched += s.batched_impacts;
         run.budget_spent += s.budget_spent;
         run.native_impacts += s.native_impacts;
     }
@@ -283,7 +289,7 @@ fn print(scene: &str, frames: usize, native: &Run, topple: &Run) {
         }
     };
     println!(
-        "| {scene} | {frames} | {:.3} | {:.2} | {} | {:.3} | {:.2} | {} | {:.3} | {:.2} | {:.2} | {:.2} | {} | {} ({}) | {} | {} | {} / {} |",
+        "| {scene} | {frames} | {:.3} | {:.2} | {} | {:.3} | {:.2} | {} | {:.3} | {:.2} | {:.2} | {:.2} | {} ({}) | {} ({}) | {} | {} | {} / {} |",
         native.mean_ms,
         native.worst_ms,
         native.slow,
@@ -295,6 +301,7 @@ fn print(scene: &str, frames: usize, native: &Run, topple: &Run) {
         topple.mean_ms / native.mean_ms,
         topple.worst_ms / native.worst_ms,
         topple.impacts,
+        topple.batched,
         topple.fallbacks,
         topple.large_fallbacks,
         topple.budget_spent,
@@ -310,7 +317,7 @@ fn main() {
         .filter(|a| !a.starts_with('-'))
         .collect();
     let want = |name: &str| wanted.is_empty() || wanted.iter().any(|w| name.contains(w.as_str()));
-    println!("| scene | frames | native mean (ms) | native worst (ms) | native frames > 1/60 s | topple mean (ms) | topple worst (ms) | topple frames > 1/60 s | topple's own (ms/frame) | topple's Rapier steps per frame | mean ratio | worst ratio | impacts | fallbacks (large groups) | budget ran out | left to Rapier | below ground (native / topple) |");
+    println!("| scene | frames | native mean (ms) | native worst (ms) | native frames > 1/60 s | topple mean (ms) | topple worst (ms) | topple frames > 1/60 s | topple's own (ms/frame) | topple's Rapier steps per frame | mean ratio | worst ratio | impacts (solved in batches) | fallbacks (large groups) | budget ran out | left to Rapier | below ground (native / topple) |");
     println!(
         "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |"
     );

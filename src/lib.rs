@@ -25,8 +25,9 @@
 //! each other in a cycle).
 //!
 //! Cargo features: `f64` and `f32` compile the two Rapier builds
-//! (`rapier::f64`, `rapier::f32`), `parallel` runs the sweeps on rayon,
-//! `bevy` adds the Bevy plugin with the f32 build only, `cli` the `topple`
+//! (`rapier::f64`, `rapier::f32`), `parallel` runs the sweeps and a Rapier
+//! step's independent impacts on rayon, `bevy` adds the Bevy plugin with the
+//! f32 build only (and `parallel`), `cli` the `topple`
 //! command; the defaults are `cli`, `f32`, `f64` and `parallel`.
 //! The Rapier crates topple is built against are re-exported, so a user does
 //! not have to spell their pre-release versions: [`rapier2d_f64`] and

@@ -242,6 +242,7 @@ fn add_frame(frame: &mut ToppleFrameStats, before: &ToppleStats, after: &ToppleS
     frame.work += after.work - before.work;
     frame.budget_spent += after.budget_spent - before.budget_spent;
     frame.native_impacts += after.native_impacts - before.native_impacts;
+    frame.batched_impacts += after.batched_impacts - before.batched_impacts;
     let t = &mut frame.totals;
     t.pairs_queried += after.pairs_queried;
     t.contact_points += after.contact_points;
@@ -256,6 +257,8 @@ fn add_frame(frame: &mut ToppleFrameStats, before: &ToppleStats, after: &ToppleS
     t.work += after.work;
     t.budget_spent += after.budget_spent;
     t.native_impacts += after.native_impacts;
+    t.batched_impacts += after.batched_impacts;
+    t.batch_resolves += after.batch_resolves;
 }
 
 /// One warning and one [`ToppleNotice`] per collider topple leaves to

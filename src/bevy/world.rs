@@ -97,6 +97,9 @@ pub struct ToppleFrameStats {
     /// got Rapier's own response this frame (colliders topple leaves to
     /// Rapier, or after the budget ran out).
     pub native_impacts: u64,
+    /// Impacts solved side by side with others of the same physics step
+    /// this frame (docs/bevy.md, "Independent impacts side by side").
+    pub batched_impacts: u64,
     /// Wall time of topple's own work this frame, Rapier excluded (s).
     pub topple_seconds: f64,
     /// Wall time of the whole physics step this frame, Rapier included (s).
@@ -142,6 +145,13 @@ impl ToppleWorld {
     /// The adapter (statistics, last impacts, settings).
     pub fn adapter(&self) -> &ToppleRapier {
         &self.adapter
+    }
+
+    /// Whether a physics step's independent impacts are solved in batches,
+    /// side by side, or one instant at a time: the same bits either way
+    /// ([`ToppleRapier::set_impact_batches`]; on by default).
+    pub fn set_impact_batches(&mut self, on: bool) {
+        self.adapter.set_impact_batches(on);
     }
 
     /// The id of a material, added on first use.

@@ -151,6 +151,10 @@ pub struct ImpactGroups {
     /// Work of the LZB attempts of the last call, all groups together
     /// ([`super::FallbackPolicy::max_work`]).
     work: u64,
+    /// Work of each group of the last call.
+    group_work: Vec<u64>,
+    /// The last call's cap on large groups ([`super::FallbackPolicy::large_group`]).
+    large_group: Option<super::LargeGroup>,
 }
 
 #[inline]
@@ -186,6 +190,35 @@ pub fn seed_approach(bodies: &[Body], c: &PointContact, settings: &ToppleSetting
     (vn < -settings.min_approach_speed && (free(c.bodies[0]) || free(c.bodies[1]))).then_some(-vn)
 }
 
+impl ImpactGroups {
+    /// A large group of `contacts` points had its LZB attempts bounded by
+    /// its cap under the budget `left` as under any larger one
+    /// ([`ImpactGroups::same_under`]).
+    fn cap_binds(&self, contacts: usize, left: u64) -> bool {
+        let Some(large) = self.large_group else {
+            return false;
+        };
+        let points = contacts.max(1) as u64;
+        left / points >= large.work / points + 2 * margin(contacts)
+    }
+}
+
+/// The steps the fallback policy keeps back from a budget before each LZB
+/// attempt of an impact of `contacts` points (one step and two settlings
+/// of the modes an attempt may take past its limit).
+fn margin(contacts: usize) -> u64 {
+    2 + 2 * (4 + 4 * contacts as u64) / 6
+}
+
+/// Whether a first LZB attempt that charged `work` on an impact of
+/// `contacts` points takes the same steps under the budget `left`
+/// ([`ImpactGroups::same_under`]): `floor(left/points) ≥ s + 1 + margin`,
+/// `s = work/points`, the margin as the fallback policy keeps it back.
+fn lzb_fits(work: u64, contacts: usize, left: u64) -> bool {
+    let points = contacts.max(1) as u64;
+    left / points >= work / points + 1 + margin(contacts)
+}
+
 fn find(parent: &mut [usize], mut i: usize) -> usize {
     while parent[i] != i {
         parent[i] = parent[parent[i]];
@@ -211,6 +244,79 @@ impl ImpactGroups {
     /// impact's contact points ([`super::FallbackPolicy::max_work`]).
     pub fn work(&self) -> u64 {
         self.work
+    }
+
+    /// Whether the last [`ImpactGroups::resolve`], called with the work
+    /// budget `given` ([`super::FallbackPolicy::max_work`]), gave the same
+    /// result as a call with the smaller budget `budget` would have: then
+    /// the impacts of a step that were solved side by side, each with the
+    /// budget left at the start, keep the budget's sequential meaning
+    /// without being solved again.
+    ///
+    /// Sufficient, not necessary: the budgets are equal, or every group
+    /// finished by the law's first attempt ([`Resolution::Lzb`]) with room
+    /// to spare under `budget`, or was a large group whose cap, not the
+    /// budget, bounded its attempts. The reason is in the fallback policy's
+    /// code ([`super::GroupSolver`]): the budget enters an attempt only as
+    /// its step limit, `floor(left / points) − margin` steps (the margin
+    /// covers the step and two settlings an attempt may take past its
+    /// limit, `2 + 2·(4 + 4·points)/6`), and the resolvers compare their
+    /// step counters with that limit and use it for nothing else (the
+    /// time-domain resolver's `attempts + settling/6 > limit`, the impulse
+    /// resolvers' `attempts > limit` and `steps ≥ limit`). A first attempt
+    /// that finished with `s` steps charged (work `s·points`, every counter
+    /// it checked at most `s + 1`) takes the same steps under any limit of
+    /// at least `s + 1`, so any budget with `floor(budget/points) ≥ s + 1 +
+    /// margin` gives the same bits. A large group's attempts are limited
+    /// by the smaller of what is left and its cap (`cap = work/points`
+    /// steps, less what the first attempt took for the second, each after
+    /// a margin): with `floor(budget/points) ≥ cap + 2·margin` the cap is
+    /// the smaller under either budget, whatever the outcome. The groups of
+    /// one call share the budget, each checked with what the groups before
+    /// it left.
+    ///
+    /// ```
+    /// use topple::impact::{Body, ContactMaterial};
+    /// use topple::coupling::{ImpactGroups, PointContact, ToppleSettings};
+    /// let mut bodies = [
+    ///     Body::new(1.0, 0.004).with_velocity([1.0, 0.0]),
+    ///     Body::new(1.0, 0.004).with_position([0.2, 0.0]),
+    /// ];
+    /// let contacts = [PointContact {
+    ///     bodies: [Some(0), Some(1)], point: [0.1, 0.0], normal: [1.0, 0.0], dist: 0.0,
+    ///     material: ContactMaterial::hertz(1e8), persistent: false,
+    /// }];
+    /// let mut settings = ToppleSettings::default();
+    /// settings.fallback.max_work = Some(50_000);
+    /// let mut groups = ImpactGroups::default();
+    /// groups.resolve(&mut bodies, &contacts, &settings);
+    /// let work = groups.work();
+    /// assert!(groups.same_under(Some(50_000), Some(50_000)));
+    /// assert!(groups.same_under(Some(50_000), Some(work + 100)));
+    /// assert!(!groups.same_under(Some(50_000), Some(work)));
+    /// ```
+    pub fn same_under(&self, given: Option<u64>, budget: Option<u64>) -> bool {
+        if given == budget {
+            return true;
+        }
+        let (Some(given), Some(budget)) = (given, budget) else {
+            return false; // a budget and none: the limits differ
+        };
+        let mut spent = 0u64;
+        for (report, &work) in self.reports.iter().zip(&self.group_work) {
+            let left = budget.saturating_sub(spent);
+            if given.saturating_sub(spent) == left {
+                return true; // the rest sees the same budget
+            }
+            let capped = report.large_group && self.cap_binds(report.contacts, left);
+            let fits =
+                report.resolution == Resolution::Lzb && lzb_fits(work, report.contacts, left);
+            if !capped && !fits {
+                return false;
+            }
+            spent += work;
+        }
+        true
     }
 
     /// The free bodies of group `g` of the last call (indices into the body
@@ -243,6 +349,8 @@ impl ImpactGroups {
         self.contact_start.push(0);
         self.body_order.clear();
         self.work = 0;
+        self.group_work.clear();
+        self.large_group = settings.fallback.large_group;
         self.find_seeds(bodies, contacts, settings);
         if self.seeds.is_empty() {
             return 0; // the common case: nothing else is done
@@ -513,6 +621,7 @@ impl ImpactGroups {
             &mut self.outcome,
         );
         self.work += self.solver.last_work();
+        self.group_work.push(self.solver.last_work());
         let resolution = result.unwrap_or(Resolution::Rejected);
         let out = &self.outcome;
         let members = &self.body_order[self.body_start[g]..self.body_start[g + 1]];
@@ -658,5 +767,79 @@ mod tests {
         assert_eq!((r.bodies, r.contacts), (3, 2));
         assert_eq!(groups.members(0), &[0, 1, 2]);
         assert_eq!(chain[3].velocity, [0.0, 0.0]);
+    }
+
+    /// `resolve` under a work budget of `work`, the whole group (no
+    /// window): the velocities, reports and work.
+    fn solved(
+        bodies: &[Body],
+        contacts: &[PointContact],
+        work: u64,
+    ) -> (Vec<Body>, Vec<ImpactReport>, u64, ImpactGroups) {
+        let settings = ToppleSettings {
+            fallback: super::super::FallbackPolicy {
+                max_work: Some(work),
+                ..super::super::FallbackPolicy::default()
+            },
+            max_group_hops: None,
+            ..ToppleSettings::default()
+        };
+        let mut groups = ImpactGroups::default();
+        let mut out = bodies.to_vec();
+        groups.resolve(&mut out, contacts, &settings);
+        (out, groups.reports().to_vec(), groups.work(), groups)
+    }
+
+    /// The smallest budget `same_under` accepts for the result solved with
+    /// `given` gives that result's bits; for a group ended by the law and
+    /// for a large group its cap ended plastic.
+    #[test]
+    fn the_smallest_budget_same_under_accepts_gives_the_same_bits() {
+        // the captured pile landing (15 boxes, 33 points): a large group
+        let input: serde_json::Value = serde_json::from_str(include_str!(
+            "../../tests/data/pile-landing-33-contacts.json"
+        ))
+        .expect("the captured impact");
+        let bodies: Vec<Body> = serde_json::from_value(input["bodies"].clone()).expect("bodies");
+        let pile: Vec<Contact> =
+            serde_json::from_value(input["contacts"].clone()).expect("contacts");
+        let pile: Vec<PointContact> = pile
+            .iter()
+            .map(|c| PointContact {
+                bodies: c.bodies,
+                point: c.point,
+                normal: c.normal,
+                dist: 0.0,
+                material: c.material,
+                persistent: false,
+            })
+            .collect();
+        // a cradle of 4 balls ended by the law
+        let mut cradle: Vec<Body> = (0..4).map(|i| ball(0.2 * i as f64, 0.0)).collect();
+        cradle[0].velocity[0] = 1.0;
+        let links: Vec<PointContact> = (0..3)
+            .map(|i| touch(i, i + 1, 0.2 * i as f64 + 0.1, false))
+            .collect();
+        let given = 50_000;
+        for (name, bodies, contacts, large) in [
+            ("pile", &bodies, &pile, true),
+            ("cradle", &cradle, &links, false),
+        ] {
+            let (v0, r0, w0, groups) = solved(bodies, contacts, given);
+            assert_eq!(r0.len(), 1, "{name}");
+            assert_eq!(r0[0].large_group, large, "{name}");
+            if large {
+                assert_eq!(r0[0].resolution, Resolution::Plastic, "{name}");
+            } else {
+                assert_eq!(r0[0].resolution, Resolution::Lzb, "{name}");
+            }
+            let least = (0..=given)
+                .find(|&w| groups.same_under(Some(given), Some(w)))
+                .expect("the budget itself");
+            assert!(least < given, "{name}: {least}");
+            assert!(!groups.same_under(Some(given), Some(least - 1)), "{name}");
+            let (v1, r1, w1, _) = solved(bodies, contacts, least);
+            assert_eq!((&v0, &r0, w0), (&v1, &r1, w1), "{name} at {least}");
+        }
     }
 }

@@ -224,6 +224,16 @@ pub struct ToppleStats {
     /// Not serialized: outputs stay the same bits from run to run.
     #[serde(skip)]
     pub topple_seconds: f64,
+    /// Impacts solved side by side with others of the same step: groups
+    /// applied from batches of two or more instants (docs/bevy.md,
+    /// "Independent impacts side by side"). Not serialized: how the work
+    /// was shared out, not what it gave.
+    #[serde(skip)]
+    pub batched_impacts: u64,
+    /// Batch items solved again, one after another, because the budget the
+    /// impacts before them spent might have changed their result.
+    #[serde(skip)]
+    pub batch_resolves: u64,
 }
 
 impl ToppleStats {

@@ -6,5 +6,6 @@
 mod cradle;
 #[path = "../../examples/common/scenes.rs"]
 mod example_scenes;
+mod parallel;
 mod row;
 mod scenes;

@@ -8,7 +8,10 @@
 //! Rapier's modified-bodies list, which Rapier's step takes away
 //! (`mem::take`), so after each impact step that list grows again from empty.
 //! The steady-state check tells those allocations apart (by a backtrace) and
-//! allows no other.
+//! allows no other. With the `parallel` feature one more: a batch of
+//! independent impacts handed to rayon's pool from outside it is pushed on
+//! the pool's injector queue (crossbeam-deque's `Injector`), which allocates
+//! a block for every 63 jobs; those are told apart the same way and bounded.
 
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::cell::Cell;
@@ -27,6 +30,12 @@ thread_local! {
     /// Of those, the ones made inside Rapier's `RigidBodySet` (its modified
     /// list), told apart by a backtrace when `ATTRIBUTE` is on.
     static RAPIER_ALLOCATIONS: Cell<usize> = const { Cell::new(0) };
+    /// Of those, the blocks of rayon's injector queue.
+    static RAYON_ALLOCATIONS: Cell<usize> = const { Cell::new(0) };
+}
+
+fn rayon_allocations() -> usize {
+    RAYON_ALLOCATIONS.with(|c| c.get())
 }
 
 fn allocations() -> usize {
@@ -48,6 +57,8 @@ fn count_one() {
         let trace = std::backtrace::Backtrace::force_capture().to_string();
         if trace.contains("RigidBodySet") {
             RAPIER_ALLOCATIONS.with(|c| c.set(c.get() + 1));
+        } else if trace.contains("Injector") {
+            RAYON_ALLOCATIONS.with(|c| c.set(c.get() + 1));
         }
         COUNTING.with(|c| c.set(true));
     }
@@ -137,7 +148,7 @@ fn a_domino_wave_allocates_nothing_once_its_buffers_have_grown() {
     sw.topple = warm.topple;
     let (mut impacts, mut allocations, mut rapier_share) = (0, 0, 0);
     ATTRIBUTE.with(|c| c.set(true));
-    let rapier_before = rapier_allocations();
+    let (rapier_before, rayon_before) = (rapier_allocations(), rayon_allocations());
     for _ in 0..steps {
         let (n, a) = counted_step(&mut sw);
         // at most every body of every group had its velocity written
@@ -148,18 +159,25 @@ fn a_domino_wave_allocates_nothing_once_its_buffers_have_grown() {
     }
     ATTRIBUTE.with(|c| c.set(false));
     let in_rapier = rapier_allocations() - rapier_before;
+    let in_rayon = rayon_allocations() - rayon_before;
     println!(
         "first run: {} impacts, {} allocations; second run: {impacts} impacts, \
          {allocations} allocations, {in_rapier} of them in Rapier's RigidBodySet \
-         (its growth from empty after each impact step allows {rapier_share})",
+         (its growth from empty after each impact step allows {rapier_share}), \
+         {in_rayon} in rayon's injector queue",
         first.0, first.1
     );
     // The test means something only if the second run resolves impacts.
     assert!(impacts > 100, "too few impacts: {impacts}");
     assert_eq!(
-        allocations - in_rapier,
+        allocations - in_rapier - in_rayon,
         0,
         "topple's own code allocated in steady state"
+    );
+    // a block per 63 batches at most (each batch is at least one impact)
+    assert!(
+        in_rayon <= 1 + impacts / 63,
+        "rayon's queue allocated {in_rayon} times"
     );
     assert!(
         in_rapier <= rapier_share,

@@ -12,6 +12,7 @@ mod dominoes;
 mod drop;
 mod fallen_baseline;
 mod game_rate;
+mod parallel;
 mod rebound;
 mod shapes;
 mod sleeping;

@@ -232,53 +232,72 @@ impl Motion {
     pub fn path(&mut self, h: RigidBodyHandle, rb: &RigidBody) -> &mut Path {
         let i = index(h);
         if *slot(&mut self.path_of, i) == NONE {
-            let (com1, angle1) = com_and_angle(rb);
-            let path = match self.start_of.get(i).copied().filter(|&s| s != NONE) {
-                _ if self.predicting => {
-                    let moving = rb.is_dynamic() && !rb.is_sleeping();
-                    let (v, w) = (rb.linvel(), f64::from(rb.angvel()));
-                    let h = if moving { self.dt } else { 0.0 };
-                    Path {
-                        t0: 0.0,
-                        com0: com1,
-                        angle0: angle1,
-                        com1: [com1[0] + f64::from(v.x) * h, com1[1] + f64::from(v.y) * h],
-                        angle1: angle1 + w * h,
-                        ..Path::default()
-                    }
-                }
-                Some(s) if rb.is_dynamic() => {
-                    let (_, com0, angle0) = self.starts[s as usize];
-                    Path {
-                        t0: 0.0,
-                        com0,
-                        angle0: unwrap_near(angle0, angle1),
-                        com1,
-                        angle1,
-                        ..Path::default()
-                    }
-                }
-                // awake but not recorded (inserted or woken since): its
-                // path is reconstructed from its velocity
-                _ if rb.is_dynamic() && !rb.is_sleeping() => {
-                    let (v, w) = (rb.linvel(), f64::from(rb.angvel()));
-                    let dt = self.dt;
-                    Path {
-                        t0: 0.0,
-                        com0: [com1[0] - f64::from(v.x) * dt, com1[1] - f64::from(v.y) * dt],
-                        angle0: angle1 - w * dt,
-                        com1,
-                        angle1,
-                        ..Path::default()
-                    }
-                }
-                _ => Path::still(com1, angle1),
-            };
+            let path = self.make(i, rb);
             self.path_of[i] = self.paths.len() as u32;
             self.paths.push(path);
             self.handles.push(h);
         }
         &mut self.paths[self.path_of[i] as usize]
+    }
+
+    /// The path of a body as [`Motion::path`] gives it, without making it
+    /// if it is not made yet: with whether it was (`false`: the path
+    /// [`Motion::path`] would make now, the same bits, since a path is made
+    /// from the body's start and end poses alone). The impact pass builds
+    /// a batch's groups with it, and makes the paths in the order the
+    /// impacts are applied ([`Motion::changed`] lists them in that order).
+    pub fn peek(&self, h: RigidBodyHandle, rb: &RigidBody) -> (Path, bool) {
+        let i = index(h);
+        match self.path_of.get(i).copied().filter(|&p| p != NONE) {
+            Some(p) => (self.paths[p as usize], true),
+            None => (self.make(i, rb), false),
+        }
+    }
+
+    /// The path of body `i` made from its start pose and its pose now.
+    fn make(&self, i: usize, rb: &RigidBody) -> Path {
+        let (com1, angle1) = com_and_angle(rb);
+        match self.start_of.get(i).copied().filter(|&s| s != NONE) {
+            _ if self.predicting => {
+                let moving = rb.is_dynamic() && !rb.is_sleeping();
+                let (v, w) = (rb.linvel(), f64::from(rb.angvel()));
+                let h = if moving { self.dt } else { 0.0 };
+                Path {
+                    t0: 0.0,
+                    com0: com1,
+                    angle0: angle1,
+                    com1: [com1[0] + f64::from(v.x) * h, com1[1] + f64::from(v.y) * h],
+                    angle1: angle1 + w * h,
+                    ..Path::default()
+                }
+            }
+            Some(s) if rb.is_dynamic() => {
+                let (_, com0, angle0) = self.starts[s as usize];
+                Path {
+                    t0: 0.0,
+                    com0,
+                    angle0: unwrap_near(angle0, angle1),
+                    com1,
+                    angle1,
+                    ..Path::default()
+                }
+            }
+            // awake but not recorded (inserted or woken since): its
+            // path is reconstructed from its velocity
+            _ if rb.is_dynamic() && !rb.is_sleeping() => {
+                let (v, w) = (rb.linvel(), f64::from(rb.angvel()));
+                let dt = self.dt;
+                Path {
+                    t0: 0.0,
+                    com0: [com1[0] - f64::from(v.x) * dt, com1[1] - f64::from(v.y) * dt],
+                    angle0: angle1 - w * dt,
+                    com1,
+                    angle1,
+                    ..Path::default()
+                }
+            }
+            _ => Path::still(com1, angle1),
+        }
     }
 
     /// The bodies whose velocity an impact changed, with their paths.

@@ -278,7 +278,26 @@ impl ToppleRapier {
         let mut s = self.stats;
         s.pairs_queried = self.pass.pairs_queried;
         s.contact_points = self.pass.contact_points;
+        s.batched_impacts = self.pass.batched;
+        s.batch_resolves = self.pass.solved_again;
         s
+    }
+
+    /// Whether a step's independent impacts are solved in batches, side by
+    /// side (on rayon's threads with the `parallel` feature), or one instant
+    /// at a time. Both give the same bits (docs/bevy.md, "Independent
+    /// impacts side by side"); batches are on by default. For tests and
+    /// measurements.
+    ///
+    /// ```
+    /// use topple::coupling::ToppleSettings;
+    /// use topple::rapier::f64::ToppleRapier;
+    /// let mut topple = ToppleRapier::new(ToppleSettings::default());
+    /// topple.set_impact_batches(false);
+    /// assert_eq!(topple.stats().batched_impacts, 0);
+    /// ```
+    pub fn set_impact_batches(&mut self, on: bool) {
+        self.pass.one_at_a_time = !on;
     }
 
     /// One step of a [`PhysicsWorld`] (see [`ToppleRapier::step_parts`]).

@@ -29,7 +29,7 @@ impl ImpactPass {
             return self.slot[i] as usize;
         }
         let rb = &world.bodies[h];
-        let path = *self.motion.path(h, rb);
+        let path = self.build_path(h, rb);
         let (com, angle) = path.at(t, self.motion.dt);
         let (velocity, angular_velocity) = if path.changed {
             (path.velocity, path.angular_velocity)
@@ -93,6 +93,7 @@ impl ImpactPass {
                     } else {
                         world.allowed
                     };
+                    self.note_reach(world, other);
                     let key = pair_key(c, other);
                     if self.queried.contains(&key) {
                         continue;

@@ -9,9 +9,11 @@
 //! | contact queries | `query.rs` | poses of a collider along its path, the gap and the contact manifolds of a pair at an instant |
 //! | time of impact | `toi.rs` | for each candidate that is closed at the end of the step, the first instant τ its gap closes along the bodies' straight paths (bracketed, then regula falsi) |
 //! | group | `group.rs` | at the earliest τ: the bodies connected to the closing pair through closed contacts (breadth first, within the impact window), their contacts from parry at the poses of τ, λ points on flat patches |
+//! | batch | `batch.rs` | the impacts of the next instants whose groups cannot meet before the last of them: built one after another, solved side by side (on several threads with the `parallel` feature), applied in time order with the same bits as one at a time |
 //! | resolve, continue | `resolve.rs` | [`ImpactGroups`]: the LZB resolver with the fallback policy under the step's work budget; each body whose velocity changed moves on from τ with its new velocity, its pairs get new times of impact; the events are recorded |
 //! | run, predict, write back | this file | the stages in order over one step; the look-ahead that splits Rapier's step; new velocities and end poses into Rapier |
 
+mod batch;
 mod candidates;
 mod group;
 mod query;
@@ -26,7 +28,7 @@ use super::backend::prelude::{
 };
 
 use super::hooks::ToppleHooks;
-use super::motion::Motion;
+use super::motion::{Motion, Path};
 use super::support::{self, Geometry, Role};
 use crate::coupling::{ImpactGroups, ImpactReport, ManifoldPoint, PointContact, ToppleSettings};
 use crate::impact::Body;
@@ -144,6 +146,34 @@ pub(crate) struct ImpactPass {
     pub work: u64,
     /// What is left of the step's work budget (`None`: no budget).
     pub work_left: Option<u64>,
+    /// Resolve the impacts one instant at a time, never in batches (the
+    /// same bits; tests compare the two).
+    pub one_at_a_time: bool,
+    /// Impact groups applied from batches of two or more instants.
+    pub batched: u64,
+    /// Batch items whose solve was done again under the budget the
+    /// sequential order left them ([`ImpactGroups::same_under`]).
+    pub solved_again: u64,
+    /// The batch being built and solved (kept between steps).
+    items: Vec<batch::Item>,
+    /// A group is being built for a batch: paths are looked at, not made
+    /// (`fresh` lists the ones to make when it is applied), and the bodies
+    /// it looks at are noted in `reach`.
+    speculative: bool,
+    fresh: Vec<RigidBodyHandle>,
+    reach: Vec<RigidBodyHandle>,
+    /// The candidates the group being built marked done.
+    seeds: Vec<usize>,
+    /// By arena index: the batch (its stamp) whose group holds the body.
+    claimed: Vec<u64>,
+    /// By arena index: the batch (its stamp) and the last item of it whose
+    /// build looked at the body.
+    reached: Vec<(u64, usize)>,
+    /// The current batch's stamp.
+    stamp: u64,
+    /// The batch item whose groups were applied last (`None`: the pass's
+    /// own, resolved one instant at a time).
+    last_item: Option<usize>,
 }
 
 const NO_SLOT: u32 = u32::MAX;
@@ -190,7 +220,10 @@ fn dynamic_parent(world: &World, co: &Collider) -> Option<RigidBodyHandle> {
 impl ImpactPass {
     /// The grouping stage.
     pub fn groups(&self) -> &ImpactGroups {
-        &self.groups
+        match self.last_item {
+            Some(j) => &self.items[j].groups,
+            None => &self.groups,
+        }
     }
 
     /// Forgets the impacts of the last step (a step may run several passes
@@ -236,11 +269,50 @@ impl ImpactPass {
             self.candidates[k].toi = self.time_of_impact(world, settings, k);
         }
         let mut groups = 0;
-        for _ in 0..MAX_EVENTS {
+        let mut events = 0;
+        while events < MAX_EVENTS {
             let Some(t) = self.earliest() else { break };
-            groups += self.resolve_at(world, hooks, settings, t, offset);
+            if self.one_at_a_time {
+                self.last_item = None;
+                groups += self.resolve_at(world, hooks, settings, t, offset);
+                events += 1;
+                continue;
+            }
+            let (applied, solved) =
+                self.batch(world, hooks, settings, t, offset, MAX_EVENTS - events);
+            events += applied;
+            groups += solved;
         }
         groups
+    }
+
+    /// The path of body `h` for the group being built: made on first use
+    /// as everywhere else, or, while a batch is built, looked at without
+    /// being made (noted in `fresh`, made when the group is applied, so
+    /// that the paths are made in the order of the sequential pass).
+    fn build_path(&mut self, h: RigidBodyHandle, rb: &RigidBody) -> Path {
+        if !self.speculative {
+            return *self.motion.path(h, rb);
+        }
+        let (path, made) = self.motion.peek(h, rb);
+        if !made && !self.fresh.contains(&h) {
+            self.fresh.push(h);
+        }
+        path
+    }
+
+    /// Notes the body of collider `c` as looked at by the group being
+    /// built for a batch.
+    fn note_reach(&mut self, world: &World, c: ColliderHandle) {
+        if !self.speculative {
+            return;
+        }
+        // a fixed or kinematic body is never moved by the pass
+        if let Some(h) = world.colliders.get(c).and_then(|co| co.parent())
+            && world.bodies.get(h).is_some_and(|rb| rb.is_dynamic())
+        {
+            self.reach.push(h);
+        }
     }
 
     /// What the next `horizon` (s) holds if every awake body keeps its

@@ -25,7 +25,7 @@ impl ImpactPass {
         {
             Some((h, rb)) if rb.is_dynamic() => {
                 let dt = self.motion.dt;
-                let (com, angle) = self.motion.path(h, rb).at(t, dt);
+                let (com, angle) = self.build_path(h, rb).at(t, dt);
                 let offset = co.position_wrt_parent().copied().unwrap_or(Pose::IDENTITY);
                 Some(body_pose(rb, com, angle) * offset)
             }

@@ -10,6 +10,26 @@ use super::{
     body_index, dynamic_parent, v2, ImpactContact, ImpactEvent, ImpactPass, World, NO_SLOT,
 };
 
+/// The settings an impact group is solved with: the step's work budget
+/// `work_left` (the impacts of a step share it), the impact started at the
+/// closing pairs' lowest `threshold` (an impact started below the frame's
+/// threshold, a rebound, still ends at the frame's rest speed).
+pub(super) fn budgeted(
+    settings: &ToppleSettings,
+    threshold: f64,
+    work_left: Option<u64>,
+) -> ToppleSettings {
+    ToppleSettings {
+        fallback: FallbackPolicy {
+            max_work: work_left,
+            ..settings.fallback
+        },
+        impact: settings.impact_settings(),
+        min_approach_speed: threshold,
+        ..*settings
+    }
+}
+
 impl ImpactPass {
     /// Resolves the impacts at time `t`: the candidates closing then, with
     /// the group around them; then lets the changed bodies move on.
@@ -21,6 +41,25 @@ impl ImpactPass {
         t: f64,
         offset: f64,
     ) -> usize {
+        let threshold = self.build_at(world, hooks, settings, t);
+        let budgeted = budgeted(settings, threshold, self.work_left);
+        let groups = self
+            .groups
+            .resolve(&mut self.bodies, &self.contacts, &budgeted);
+        self.finish_at(world, hooks, settings, t, offset, groups)
+    }
+
+    /// Builds the group of the impacts at time `t` into `bodies`, `handles`
+    /// and `contacts`: the candidates closing then (marked done, their
+    /// indices in `seeds`) and the bodies connected to them. Returns the
+    /// lowest threshold of the closing pairs, which starts the impact.
+    pub(super) fn build_at(
+        &mut self,
+        world: &World,
+        hooks: &ToppleHooks,
+        settings: &ToppleSettings,
+        t: f64,
+    ) -> f64 {
         let at_once = 1e-9 * self.motion.dt;
         // the lowest threshold of the pairs closing now starts the impact
         let mut threshold = settings.min_approach_speed;
@@ -28,14 +67,18 @@ impl ImpactPass {
         self.handles.clear();
         self.contacts.clear();
         self.queried.clear();
+        self.seeds.clear();
         for k in 0..self.candidates.len() {
             let c = self.candidates[k];
             if c.done || c.toi > t + at_once {
                 continue;
             }
             self.candidates[k].done = true;
+            self.seeds.push(k);
             threshold = threshold.min(c.threshold);
             self.queried.push(c.key);
+            self.note_reach(world, c.colliders[0]);
+            self.note_reach(world, c.colliders[1]);
             self.query_pair(
                 world,
                 hooks,
@@ -61,21 +104,25 @@ impl ImpactPass {
         };
         self.expand_group(world, hooks, &window, t);
         self.contact_points += self.contacts.len() as u64;
-        // the impacts of a step share its work budget; an impact started
-        // below the frame's threshold (a rebound) still ends at the frame's
-        // rest speed
-        let budgeted = ToppleSettings {
-            fallback: FallbackPolicy {
-                max_work: self.work_left,
-                ..settings.fallback
-            },
-            impact: settings.impact_settings(),
-            min_approach_speed: threshold,
-            ..*settings
-        };
-        let groups = self
-            .groups
-            .resolve(&mut self.bodies, &self.contacts, &budgeted);
+        for h in &self.handles {
+            self.slot[body_index(*h)] = NO_SLOT;
+        }
+        threshold
+    }
+
+    /// After the groups built at `t` were solved (`groups` of them, in
+    /// `groups`, with `bodies` holding their new velocities): the work
+    /// taken from the step's budget, the events recorded, the changed
+    /// bodies moved on. Returns `groups`.
+    pub(super) fn finish_at(
+        &mut self,
+        world: &World,
+        hooks: &ToppleHooks,
+        settings: &ToppleSettings,
+        t: f64,
+        offset: f64,
+        groups: usize,
+    ) -> usize {
         let work = self.groups.work();
         self.work += work;
         // the plastic fallback's sweeps (each over the impact's contact
@@ -89,9 +136,6 @@ impl ImpactPass {
             *left = left.saturating_sub(work + sweeps);
         }
         self.record(offset + t, groups);
-        for h in &self.handles {
-            self.slot[body_index(*h)] = NO_SLOT;
-        }
         self.move_on(world, hooks, settings, t, groups);
         groups
     }
