@@ -230,6 +230,15 @@ pub fn gains_energy(out: &ImpactOutcome) -> bool {
 /// limit counts them the same way).
 const SETTLING_PER_STEP: usize = 6;
 
+/// The steps the policy keeps back from a work budget before each LZB
+/// attempt of an impact of `contacts` points: an attempt stops at its step
+/// limit, checked before each step and each free flight, so it may end one
+/// step and two settlings of the modes (each at most 4 + 2 (points +
+/// patches) evaluations, patches ≤ points) beyond it.
+pub(super) fn budget_margin(contacts: usize) -> u64 {
+    2 + 2 * (4 + 4 * contacts as u64) / SETTLING_PER_STEP as u64
+}
+
 fn unfinished(r: &Result<(), ImpactError>) -> bool {
     matches!(
         r,
@@ -289,12 +298,9 @@ impl GroupSolver {
         } else {
             policy.max_steps
         };
-        // an attempt stops at its step limit, checked before each step and
-        // each free flight, so it may end one step and two settlings of the
-        // modes (each at most 4 + 2 (points + patches) evaluations, patches
-        // ≤ points) beyond it: that much is kept back from the budget
+        // what an attempt may take past its step limit is kept back
         let margin = if policy.max_work.is_some() {
-            2 + 2 * (4 + 4 * contacts.len()) / SETTLING_PER_STEP
+            usize::try_from(budget_margin(contacts.len())).unwrap_or(usize::MAX)
         } else {
             0
         };

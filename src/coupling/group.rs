@@ -199,15 +199,8 @@ impl ImpactGroups {
             return false;
         };
         let points = contacts.max(1) as u64;
-        left / points >= large.work / points + 2 * margin(contacts)
+        left / points >= large.work / points + 2 * super::fallback::budget_margin(contacts)
     }
-}
-
-/// The steps the fallback policy keeps back from a budget before each LZB
-/// attempt of an impact of `contacts` points (one step and two settlings
-/// of the modes an attempt may take past its limit).
-fn margin(contacts: usize) -> u64 {
-    2 + 2 * (4 + 4 * contacts as u64) / 6
 }
 
 /// Whether a first LZB attempt that charged `work` on an impact of
@@ -216,7 +209,7 @@ fn margin(contacts: usize) -> u64 {
 /// `s = work/points`, the margin as the fallback policy keeps it back.
 fn lzb_fits(work: u64, contacts: usize, left: u64) -> bool {
     let points = contacts.max(1) as u64;
-    left / points >= work / points + 1 + margin(contacts)
+    left / points >= work / points + 1 + super::fallback::budget_margin(contacts)
 }
 
 fn find(parent: &mut [usize], mut i: usize) -> usize {
