@@ -55,6 +55,13 @@ pub fn finish() -> AuditSummary {
     AUDIT.with(|a| a.borrow_mut().take().unwrap_or_default())
 }
 
+/// Whether this thread is checking impacts (between [`start`] and
+/// [`finish`]). The Rapier pass then solves its impacts one instant at a
+/// time on this thread, so that every one of them is checked.
+pub fn is_on() -> bool {
+    AUDIT.with(|a| a.borrow().is_some())
+}
+
 /// Records an accepted impact if this thread is checking (see [`start`]).
 pub fn record(bodies: &[Body], contacts: &[Contact], out: &ImpactOutcome) {
     AUDIT.with(|a| {

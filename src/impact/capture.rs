@@ -49,6 +49,13 @@ pub fn finish() -> Vec<CapturedImpact> {
     CAPTURE.with(|c| c.borrow_mut().take().unwrap_or_default())
 }
 
+/// Whether this thread is recording impacts (between [`start`] and
+/// [`finish`]). The Rapier pass then solves its impacts one instant at a
+/// time on this thread, so that every one of them is recorded.
+pub fn is_on() -> bool {
+    CAPTURE.with(|c| c.borrow().is_some())
+}
+
 /// Records an impact if this thread is recording.
 pub(crate) fn record(bodies: &[Body], contacts: &[Contact], settings: &ImpactSettings) {
     CAPTURE.with(|c| {

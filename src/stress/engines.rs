@@ -187,9 +187,6 @@ macro_rules! rapier_runner {
                     return watch.seen;
                 }
             };
-            // the audit records the impacts solved on this thread: no batches
-            // on rayon's (the same bits either way)
-            sw.topple.set_impact_batches(false);
             let Some(row) = sw.row.clone() else {
                 watch.seen.error = Some("the scene has no row".into());
                 return watch.seen;

@@ -269,3 +269,32 @@ fn tip_steps(trace: &Trace, range: std::ops::Range<usize>) -> Vec<Option<usize>>
         })
         .collect()
 }
+
+/// The audit and the capture of impacts record on the stepping thread: while
+/// either is on, the pass solves every impact there, one instant at a time,
+/// so that none is missed. The far-apart rows, audited and captured with
+/// batches left on, record every impact the same run records with batches
+/// switched off, and solve none side by side.
+#[test]
+fn audited_and_captured_runs_miss_no_impact() {
+    let scene = rows(6, WorkBudget::Default);
+    let (_, in_batches, _) = run(&scene, true, 60);
+    assert!(in_batches > 0, "the run must have batches to miss");
+    let recorded = |batches: bool| {
+        let mut sw = build(&scene, ImpactResponse::Topple).unwrap();
+        sw.topple.set_impact_batches(batches);
+        topple::impact::audit::start();
+        topple::impact::capture::start();
+        for _ in 0..60 {
+            sw.step();
+        }
+        let captured = topple::impact::capture::finish().len();
+        let audited = topple::impact::audit::finish().impacts;
+        (captured, audited, sw.topple.stats().batched_impacts)
+    };
+    let (captured, audited, batched) = recorded(true);
+    let (captured_alone, audited_alone, _) = recorded(false);
+    assert_eq!(batched, 0);
+    assert!(audited > 0 && captured > 0);
+    assert_eq!((captured, audited), (captured_alone, audited_alone));
+}

@@ -422,9 +422,6 @@ macro_rules! watcher_for {
                         return seen;
                     }
                 };
-                // the audit records the impacts solved on this thread: no
-                // batches on rayon's (the same bits either way)
-                sw.topple.set_impact_batches(false);
                 let handles: Vec<(RigidBodyHandle, ColliderHandle)> =
                     sw.bodies.iter().map(|b| (b.1, b.2)).collect();
                 let sizes: Vec<f64> = handles.iter().map(|h| least_width(&sw, h.1)).collect();

@@ -270,9 +270,13 @@ impl ImpactPass {
         }
         let mut groups = 0;
         let mut events = 0;
+        // the audit and the capture of impacts record on the calling
+        // thread: while either is on, every impact is solved here
+        let one_at_a_time =
+            self.one_at_a_time || crate::impact::audit::is_on() || crate::impact::capture::is_on();
         while events < MAX_EVENTS {
             let Some(t) = self.earliest() else { break };
-            if self.one_at_a_time {
+            if one_at_a_time {
                 self.last_item = None;
                 groups += self.resolve_at(world, hooks, settings, t, offset);
                 events += 1;
