@@ -277,7 +277,7 @@ fn tip_steps(trace: &Trace, range: std::ops::Range<usize>) -> Vec<Option<usize>>
 /// switched off, and solve none side by side.
 #[test]
 fn audited_and_captured_runs_miss_no_impact() {
-    let scene = rows(6, WorkBudget::Default);
+    let scene = rows(6, WorkBudget::default());
     let (_, in_batches, _) = run(&scene, true, 60);
     assert!(in_batches > 0, "the run must have batches to miss");
     let recorded = |batches: bool| {
