@@ -25,7 +25,13 @@
 //! ground's top face. A second table gives the CPU time of the process per
 //! frame (`CLOCK_PROCESS_CPUTIME_ID`, all of Bevy's threads), mean and
 //! worst, for both engines: on a loaded machine wall-clock frames stretch
-//! with the load, CPU time much less.
+//! with the load, CPU time much less; and the wall time of the physics step
+//! alone per frame (`ToppleFrameStats::step_seconds`: bevy_rapier's step in
+//! the native app, topple's whole step with its Rapier pieces in topple's),
+//! which leaves out Bevy's schedule around it. On an idle virtual machine a
+//! frame's wall time holds the wake-ups of Bevy's executor threads, which
+//! cost as much as a small scene's physics (docs/bevy.md, "The frame bench
+//! on an idle machine"); the physics step's ratio does not.
 
 #[path = "../examples/common/scenes.rs"]
 mod scenes;
@@ -51,6 +57,10 @@ struct Run {
     /// Frames longer than 1/60 s.
     slow: usize,
     topple_ms: f64,
+    /// Wall time of the physics step system per frame (ms): bevy_rapier's
+    /// step for native, topple's whole step (Rapier's pieces included) for
+    /// topple; Bevy's schedule around it is left out.
+    step_ms: f64,
     /// Rapier steps per frame (topple's sub-steps and splits; native's
     /// bevy_rapier step is not counted here: one a frame at `Fixed`).
     rapier_steps: f64,
@@ -76,6 +86,7 @@ fn measure(app: &mut App, frames: usize, ground_y: f32) -> Run {
         cpu_worst_ms: 0.0,
         slow: 0,
         topple_ms: 0.0,
+        step_ms: 0.0,
         rapier_steps: 0.0,
         impacts: 0,
         fallbacks: 0,
@@ -113,6 +124,7 @@ fn measure(app: &mut App, frames: usize, ground_y: f32) -> Run {
         run.slow += usize::from(ms > 1e3 / 60.0);
         let s = app.world().resource::<ToppleFrameStats>();
         run.topple_ms += 1e3 * s.topple_seconds;
+        run.step_ms += 1e3 * s.step_seconds;
         run.rapier_steps += s.rapier_steps as f64;
         run.impacts += s.impacts;
         run.fallbacks += s.fallbacks;
@@ -124,6 +136,7 @@ fn measure(app: &mut App, frames: usize, ground_y: f32) -> Run {
     run.mean_ms = 1e3 * start.elapsed().as_secs_f64() / frames as f64;
     run.cpu_mean_ms = (process_cpu_ms() - cpu_start) / frames as f64;
     run.topple_ms /= frames as f64;
+    run.step_ms /= frames as f64;
     run.rapier_steps /= frames as f64;
     let world = app.world_mut();
     let mut q = world.query_filtered::<(&Transform, &Velocity, &Collider), With<RigidBody>>();
@@ -273,13 +286,16 @@ fn print(scene: &str, frames: usize, native: &Run, topple: &Run) {
         .lock()
         .unwrap_or_else(|e| e.into_inner())
         .push(format!(
-            "| {scene} | {:.3} | {:.2} | {:.3} | {:.2} | {:.2} | {:.2} |",
+            "| {scene} | {:.3} | {:.2} | {:.3} | {:.2} | {:.2} | {:.2} | {:.3} | {:.3} | {:.2} |",
             native.cpu_mean_ms,
             native.cpu_worst_ms,
             topple.cpu_mean_ms,
             topple.cpu_worst_ms,
             topple.cpu_mean_ms / native.cpu_mean_ms,
             topple.cpu_worst_ms / native.cpu_worst_ms,
+            native.step_ms,
+            topple.step_ms,
+            topple.step_ms / native.step_ms,
         ));
     let sane = |r: &Run| {
         if r.nan {
@@ -375,8 +391,8 @@ fn main() {
             .extend([native_fell.row("native"), topple_fell.row("topple")]);
     }
     println!();
-    println!("| scene (CPU time of the process per frame) | native mean (ms) | native worst (ms) | topple mean (ms) | topple worst (ms) | mean ratio | worst ratio |");
-    println!("| --- | --- | --- | --- | --- | --- | --- |");
+    println!("| scene (CPU time of the process per frame; physics step's wall time per frame) | native mean (ms) | native worst (ms) | topple mean (ms) | topple worst (ms) | mean ratio | worst ratio | native physics step (ms) | topple physics step (ms) | physics step ratio |");
+    println!("| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |");
     for row in CPU_ROWS.lock().unwrap_or_else(|e| e.into_inner()).iter() {
         println!("{row}");
     }
