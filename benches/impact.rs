@@ -27,9 +27,7 @@
 //! difference of any body (ω through its radius of gyration) over the
 //! impact's largest body speed, the worst over the class.
 //!
-//! `cargo bench --bench impact` prints two tables first (one run per
-//! setting): the two Runge–Kutta pairs side by side (steps and evaluations
-//! per impact; `IMPACT_PAIRS_ONLY=1` stops after it), then every step control;
+//! `cargo bench --bench impact` prints the table first (one run per setting),
 //! then criterion times each setting on each class.
 
 #[path = "../tests/common/compliant.rs"]
@@ -44,9 +42,7 @@ use std::time::Instant;
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use topple::impact::capture::CapturedImpact;
-use topple::impact::{
-    Body, BodyVelocity, Contact, ContactMaterial, ImpactSettings, ImpactSolver, RkPair,
-};
+use topple::impact::{Body, BodyVelocity, Contact, ContactMaterial, ImpactSettings, ImpactSolver};
 
 /// One impact and its converged answer ([vx, vy, ω] per body; empty when
 /// neither converged run finished within its step limit).
@@ -317,30 +313,16 @@ struct Measured {
     worst: f64,
     /// Impacts that ended in an error (the step limit).
     failed: usize,
-    /// Accepted steps and right-hand-side evaluations per impact, sorted.
-    steps: Vec<usize>,
-    evaluations: Vec<usize>,
-}
-
-/// The value at fraction `f` of a sorted list (0 if empty).
-fn quantile(sorted: &[usize], f: f64) -> usize {
-    if sorted.is_empty() {
-        return 0;
-    }
-    let i = ((sorted.len() as f64 * f) as usize).min(sorted.len() - 1);
-    sorted[i]
 }
 
 /// Solves every impact of a class.
 fn measure(class: &Class, solver: &mut ImpactSolver, s: &ImpactSettings) -> Measured {
     let mut steps = Vec::new();
-    let mut evaluations = Vec::new();
     let (mut worst, mut failed) = (0.0f64, 0);
     for impact in &class.impacts {
         match solver.solve(&impact.bodies, &impact.contacts, s) {
             Ok(out) => {
                 steps.push(out.steps);
-                evaluations.push(out.evaluations);
                 if !impact.reference.is_empty() {
                     worst = worst.max(error(impact, &velocities(&out.bodies)));
                 }
@@ -350,63 +332,11 @@ fn measure(class: &Class, solver: &mut ImpactSolver, s: &ImpactSettings) -> Meas
     }
     let mean = steps.iter().sum::<usize>() as f64 / steps.len().max(1) as f64;
     steps.sort_unstable();
-    evaluations.sort_unstable();
     Measured {
         median: steps.get(steps.len() / 2).copied().unwrap_or(0),
         mean,
         worst,
         failed,
-        steps,
-        evaluations,
-    }
-}
-
-/// The two Runge–Kutta pairs side by side (docs/impact.md, "Steps per
-/// impact, round thirteen"): per class and tolerance, accepted steps and
-/// right-hand-side evaluations per impact (median, 90th percentile, mean)
-/// and the error against the converged answer.
-fn pairs_table(classes: &[Class], solver: &mut ImpactSolver) {
-    let rest = topple::coupling::ToppleSettings::DEFAULT_REST_FRACTION * THRESHOLD_1_60;
-    let tolerances: [(&str, f64, f64); 6] = [
-        ("10⁻⁴ at 0.01", 1e-4, rest),
-        ("10⁻⁵ at 0.01", 1e-5, rest),
-        ("10⁻⁶ at 0.01 (plugin default)", 1e-6, rest),
-        ("2·10⁻⁶ at 0.01", 2e-6, rest),
-        ("10⁻⁷ at 0.01", 1e-7, rest),
-        ("2·10⁻⁶ (default)", 2e-6, 0.0),
-    ];
-    let pairs = [
-        ("DP5(4)", RkPair::DormandPrince54),
-        ("BS3(2)", RkPair::BogackiShampine32),
-    ];
-    println!(
-        "\n| class | tolerance | pair | steps median / p90 | evaluations median / p90 / mean | error / speed | failed |"
-    );
-    println!("| --- | --- | --- | ---: | ---: | ---: | ---: |");
-    for class in classes {
-        for (label, tolerance, rest_speed) in tolerances {
-            for (name, pair) in pairs {
-                let s = ImpactSettings {
-                    rest_speed,
-                    pair,
-                    max_steps: 1_000_000,
-                    ..ImpactSettings::adaptive(tolerance)
-                };
-                let m = measure(class, solver, &s);
-                let evals = &m.evaluations;
-                let mean = evals.iter().sum::<usize>() as f64 / evals.len().max(1) as f64;
-                println!(
-                    "| {} | {label} | {name} | {} / {} | {} / {} / {mean:.0} | {:.1e} | {} |",
-                    class.name,
-                    quantile(&m.steps, 0.5),
-                    quantile(&m.steps, 0.9),
-                    quantile(evals, 0.5),
-                    quantile(evals, 0.9),
-                    m.worst,
-                    m.failed,
-                );
-            }
-        }
     }
 }
 
@@ -417,8 +347,7 @@ fn pairs_table(classes: &[Class], solver: &mut ImpactSolver) {
 /// the converged runs, the table or criterion, so that `valgrind
 /// --tool=callgrind` on the bench binary counts the resolver alone (the
 /// leaning trains, `leaning20` and `domino20`, are built rather than
-/// read). `IMPACT_PAIR=bs3` or `dp5` picks the Runge–Kutta pair. Prints
-/// the class's accepted steps and right-hand-side evaluations.
+/// read). Prints the class's accepted steps.
 fn profile(name: &str) {
     let file = match name {
         "leaning20" | "domino20" => "",
@@ -453,29 +382,22 @@ fn profile(name: &str) {
         topple::coupling::ToppleSettings::default().impact,
         ImpactSettings::adaptive,
     );
-    let pair = match std::env::var("IMPACT_PAIR").as_deref() {
-        Ok("bs3") => RkPair::BogackiShampine32,
-        Ok("dp5") => RkPair::DormandPrince54,
-        _ => base.pair,
-    };
     let s = ImpactSettings {
         rest_speed: fraction * THRESHOLD_1_60,
         max_steps: 1_000_000,
-        pair,
         ..base
     };
     let mut solver = ImpactSolver::new();
-    let (mut steps, mut evaluations) = (0, 0);
+    let mut steps = 0;
     for _ in 0..repeat {
         for (bodies, contacts) in &impacts {
             if let Ok(out) = solver.solve(bodies, contacts, &s) {
                 steps += out.steps;
-                evaluations += out.evaluations;
             }
         }
     }
     println!(
-        "{name}: {} impacts x {repeat}, {steps} steps, {evaluations} evaluations ({pair:?})",
+        "{name}: {} impacts x {repeat}, {steps} steps",
         impacts.len()
     );
 }
@@ -496,10 +418,6 @@ fn bench(c: &mut Criterion) {
         captured("cradle-5", "cradle-5.jsonl"),
     ];
     let mut solver = ImpactSolver::new();
-    pairs_table(&classes, &mut solver);
-    if std::env::var("IMPACT_PAIRS_ONLY").is_ok() {
-        return;
-    }
     println!(
         "\n| class | impacts | step control | steps (median) | steps (mean) | time per impact | error / speed | failed | check |"
     );

@@ -43,7 +43,7 @@ pub use body::{Body, BodyVelocity};
 pub use contact::{Contact, ContactMaterial};
 pub use error::ImpactError;
 pub use outcome::{ContactImpulse, ImpactOutcome, StopReason};
-pub use settings::{ImpactSettings, RkPair, StepControl};
+pub use settings::{ImpactSettings, StepControl};
 pub use solver::ImpactSolver;
 
 /// Resolves one impact with a fresh solver (see [`ImpactSolver::solve`]).

@@ -55,12 +55,6 @@ pub struct ImpactOutcome {
     /// engines' work budget (`crate::coupling::FallbackPolicy::max_work`).
     #[serde(default)]
     pub settling_evaluations: usize,
-    /// Right-hand-side evaluations of the time-domain resolver in all:
-    /// stages, settling, the searches of constraint forces (0 for the
-    /// impulse stepping). The measure of its work that does not depend on
-    /// the Runge–Kutta pair ([`crate::impact::RkPair`]).
-    #[serde(default)]
-    pub evaluations: usize,
     /// Why the resolver stopped.
     pub stop_reason: Option<StopReason>,
 }

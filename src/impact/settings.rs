@@ -55,34 +55,6 @@ impl StepControl {
     }
 }
 
-/// The Runge–Kutta pair of the time-domain solver
-/// ([`StepControl::Adaptive`]; the impulse stepping ignores it).
-///
-/// ```
-/// use topple::impact::{ImpactSettings, RkPair};
-/// let low = ImpactSettings { pair: RkPair::BogackiShampine32, ..ImpactSettings::adaptive(1e-6) };
-/// assert_eq!(low.pair.low_order_at(1e-10), true);
-/// assert_eq!(RkPair::DormandPrince54.low_order_at(1e-3), false);
-/// ```
-#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
-pub enum RkPair {
-    /// Dormand and Prince's pair of orders 5 and 4 (1980): six evaluations
-    /// of the right-hand side per accepted step, an interpolant of order 4.
-    #[default]
-    DormandPrince54,
-    /// Bogacki and Shampine's pair of orders 3 and 2 (1989): three
-    /// evaluations per accepted step, the cubic Hermite interpolant.
-    BogackiShampine32,
-}
-
-impl RkPair {
-    /// Whether the solver steps with the lower-order pair at `tolerance`.
-    pub fn low_order_at(self, tolerance: f64) -> bool {
-        let _ = tolerance;
-        self == RkPair::BogackiShampine32
-    }
-}
-
 impl Default for StepControl {
     fn default() -> Self {
         StepControl::Adaptive {
@@ -150,9 +122,6 @@ pub struct ImpactSettings {
     /// ([`crate::coupling::ToppleSettings::rest_fraction`]).
     #[serde(default)]
     pub rest_speed: f64,
-    /// The Runge–Kutta pair of the time-domain solver ([`RkPair`]).
-    #[serde(default)]
-    pub pair: RkPair,
 }
 
 fn default_fast_cycle() -> f64 {
@@ -167,7 +136,6 @@ impl Default for ImpactSettings {
             e0_hold: false,
             fast_cycle: Self::FAST_CYCLE,
             rest_speed: 0.0,
-            pair: RkPair::default(),
         }
     }
 }

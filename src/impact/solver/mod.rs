@@ -20,7 +20,7 @@
 //! | `law.rs` | the contact law: force, stored energy, dq/dt in compression and expansion |
 //! | `rhs.rs` | dy/dt: normal forces, sliding friction, constraint forces; the probe of each mode's condition |
 //! | `constraints.rs` | stuck patches and held points: A = J M⁻¹ Dᵀ factored once per set, solved per evaluation |
-//! | `tableau.rs` | the Runge–Kutta pairs (Dormand–Prince 5(4), Bogacki–Shampine 3(2)): stages, error estimates, interpolants |
+//! | `tableau.rs` | the Dormand–Prince 5(4) pair: stages, error estimate, interpolant |
 //! | `rk.rs` | one step of the pair on the impact, its error norm |
 //! | `events.rs` | the switches inside a step, located on the interpolant |
 //! | `modes.rs` | the modes at an instant: touching points, stick and slip, held points |
@@ -138,7 +138,6 @@ impl ImpactSolver {
         validate::check(bodies, contacts, settings)?;
         capture::record(bodies, contacts, settings);
         out.settling_evaluations = 0;
-        out.evaluations = 0;
         match settings.step_control {
             // A lone contact: in the impulse its law is exact to rounding
             // (the velocities are linear in P and the energy's quadrature
@@ -183,9 +182,6 @@ pub(crate) struct Integrator {
     members: Vec<usize>,
     scales: Scales,
     tolerance: f64,
-    /// Steps with Bogacki–Shampine 3(2) instead of Dormand–Prince 5(4)
-    /// ([`crate::impact::RkPair`]).
-    low_order: bool,
     min_step: f64,
     /// An e = 0 point is held after a load cycle that moved its rate by at
     /// most this much (m/s; ∞ with e0_hold): `fast_cycle` times the
@@ -211,9 +207,6 @@ pub(crate) struct Integrator {
     /// Right-hand-side evaluations spent settling modes in this impact
     /// ([`ImpactOutcome::settling_evaluations`]).
     settling: usize,
-    /// Right-hand-side evaluations in this impact, all told
-    /// ([`ImpactOutcome::evaluations`]).
-    evaluations: usize,
     // probe and events
     suspects: Vec<Suspect>,
     generation: u32,
@@ -247,7 +240,6 @@ impl Integrator {
     ) -> Result<(), ImpactError> {
         self.load(bodies, contacts);
         self.tolerance = tolerance;
-        self.low_order = settings.pair.low_order_at(tolerance);
         self.cycle_bound = if settings.e0_hold {
             f64::INFINITY
         } else if settings.fast_cycle > 0.0 {
@@ -266,10 +258,8 @@ impl Integrator {
         out.steps = 0;
         out.rejected_steps = 0;
         self.settling = 0;
-        self.evaluations = 0;
         let reason = self.run(settings.max_steps, out);
         out.settling_evaluations = self.settling;
-        out.evaluations = self.evaluations;
         self.finish(bodies, reason?, out);
         Ok(())
     }

@@ -59,7 +59,6 @@ impl Integrator {
     /// dy/dt at state `y` into `dy`. With `probe`, notes the points and
     /// patches whose mode's condition fails at `y` (see events.rs).
     pub(super) fn eval(&mut self, y: &[f64], dy: &mut [f64], probe: bool) {
-        self.evaluations += 1;
         let lay = self.layout;
         let (acc, rest) = dy.split_at_mut(3 * lay.bodies);
         acc.fill(0.0);

@@ -1,14 +1,15 @@
 //! Stage 4: one Runge–Kutta step of the impact's equations and its error
-//! norm (the pairs themselves, their stages and interpolants: tableau.rs).
+//! norm (the pair itself, its stages and interpolant: tableau.rs).
 //!
-//! The step is generic over the pair ([`Pair`]): Dormand–Prince 5(4),
-//! seven stages, six evaluations per accepted step; or Bogacki–Shampine
-//! 3(2), four stages, three evaluations per accepted step (both first same
-//! as last). Either gives the state anywhere inside the step from five
-//! coefficient vectors, which the event stage searches for switches.
+//! The embedded pair of Dormand and Prince (1980) of orders 5 and 4 with
+//! seven stages, the last evaluated at the new state (first same as last, so
+//! six evaluations per accepted step), and the continuous extension of order
+//! 4 given by Hairer, Nørsett and Wanner (*Solving Ordinary Differential
+//! Equations I*, 2nd ed., Sec. II.6): the state anywhere inside the step from
+//! five coefficient vectors, which the event stage searches for switches.
 
 use super::data::{normal_rate, PointMode, Variable};
-use super::tableau::{error_estimate, scale, stage_state, Pair, Rk};
+use super::tableau::{error_estimate, scale, stage_state, Rk, C};
 use super::Integrator;
 
 impl Integrator {
@@ -33,9 +34,8 @@ impl Integrator {
     /// One trial step of length `h` (in the segment's x, see `Clock`) from
     /// `rk.y0`; returns the error estimate over the tolerance (≤ 1:
     /// acceptable; NaN if the state is not finite). The stages hold dy/dx =
-    /// dy/dt · dt/dx. The probe notes the switches seen at every stage but
-    /// the first.
-    pub(super) fn rk_step<P: Pair>(&mut self, rk: &mut Rk, h: f64) -> f64 {
+    /// dy/dt · dt/dx. The probe notes the switches seen at stages 2–7.
+    pub(super) fn rk_step(&mut self, rk: &mut Rk, h: f64) -> f64 {
         let len = rk.y0.len();
         rk.h = h;
         rk.dense_ready = false;
@@ -70,30 +70,28 @@ impl Integrator {
         // the inner stages need only what the right-hand side reads (the
         // velocities and compressions); the last one is the whole new state
         let core = self.layout.q(self.layout.contacts);
-        let last = P::STAGES - 1;
-        for (s, &c) in P::C.iter().enumerate().skip(1) {
-            let upto = if s == last { len } else { core };
-            stage_state::<P>(&mut rk.stage[..upto], &rk.y0, &rk.k, s, h);
+        for (s, &c) in C.iter().enumerate().skip(1) {
+            let upto = if s == 6 { len } else { core };
+            stage_state(&mut rk.stage[..upto], &rk.y0, &rk.k, s, h);
             let (stage, k) = (&rk.stage, &mut rk.k[s]);
             self.eval(stage, k, true);
             scale(k, self.slope(x0 + c * h, stage));
-            if s == last {
-                // the last stage is the new state (its row of A holds the
-                // weights b)
+            if s == 6 {
+                // the last stage is the new state (A[6] holds the weights b)
                 rk.y1.copy_from_slice(&rk.stage);
             }
         }
-        self.error_norm::<P>(rk, h)
+        self.error_norm(rk, h)
     }
 
     /// max over the state's parts of |error| / scale, over the tolerance:
     /// body velocities against the velocity scale (ω through the radius of
     /// gyration), compressions against their own scale; the impulses are
     /// outputs and follow the velocities.
-    fn error_norm<P: Pair>(&self, rk: &mut Rk, h: f64) -> f64 {
+    fn error_norm(&self, rk: &mut Rk, h: f64) -> f64 {
         let lay = self.layout;
         let core = lay.q(lay.contacts);
-        error_estimate::<P>(&mut rk.err[..core], &rk.k, h);
+        error_estimate(&mut rk.err[..core], &rk.k, h);
         let err = |j: usize| rk.err[j];
         let v = self.scales.velocity;
         let mut worst = 0.0f64;

@@ -2,8 +2,8 @@
 //! contacts, the end of the impact.
 //!
 //! A step is accepted when its error estimate is within the tolerance; the
-//! next step is about h · 0.9 err^(−1/(p̂+1)), between 0.2 h and 5 h, p̂ the
-//! lower order of the pair (4 for Dormand–Prince, 2 for Bogacki–Shampine). A point whose gap closes while it
+//! next step is h · 0.9 err^(−1/5), between 0.2 h and 5 h (the usual
+//! controller of a fifth-order pair). A point whose gap closes while it
 //! approaches starts with a force growing as t^α, which no polynomial in t
 //! follows: such a segment is stepped in x = √(t − t₀) (see `Clock`), its
 //! first step a fraction of the square root of the point's time scale.
@@ -19,27 +19,22 @@
 
 use super::super::{ImpactError, ImpactOutcome, StopReason};
 use super::data::{normal_rate, Clock, PointMode, Variable};
-use super::tableau::{Bs32, Dp54, Pair, Rk};
+use super::tableau::Rk;
 use super::Integrator;
 
 /// The step size controller of Hairer, Nørsett and Wanner's DOPRI5 (a
 /// proportional–integral controller, *Solving ODEs I* Sec. II.4 and IV.2):
-/// the next step is h / (err^(a − 3β/4) err_prev^(−β) / 0.9), between
-/// 0.2 h and 5 h, with β = 0.04 and a = 1/(p̂ + 1) the pair's exponent (1/5
-/// for Dormand–Prince, 1/3 for Bogacki–Shampine); a rejected step shrinks
-/// by err^(−(a − 3β/4)) · 0.9, at least to 0.2 h.
+/// the next step is h / (err^(1/5 − 3β/4) err_prev^(−β) / 0.9), between
+/// 0.2 h and 5 h, with β = 0.04; a rejected step shrinks by
+/// err^(−(1/5 − 3β/4)) · 0.9, at least to 0.2 h.
 #[derive(Clone, Copy, Debug)]
 struct Controller {
     previous: f64,
-    exponent: f64,
 }
 
-impl Controller {
-    fn new<P: Pair>() -> Self {
-        Controller {
-            previous: 1e-4,
-            exponent: P::EXPONENT,
-        }
+impl Default for Controller {
+    fn default() -> Self {
+        Controller { previous: 1e-4 }
     }
 }
 
@@ -52,7 +47,7 @@ impl Controller {
     /// The factor of the next step after an accepted one (err ≤ 1).
     fn accepted(&mut self, err: f64) -> f64 {
         let err = err.max(1e-10);
-        let factor = err.powf(self.exponent - 0.75 * BETA) / self.previous.powf(BETA) / SAFETY;
+        let factor = err.powf(0.2 - 0.75 * BETA) / self.previous.powf(BETA) / SAFETY;
         self.previous = err.max(1e-4);
         (1.0 / factor).clamp(SHRINK, GROW)
     }
@@ -62,20 +57,22 @@ impl Controller {
         if err.is_nan() {
             return SHRINK;
         }
-        (SAFETY / err.powf(self.exponent - 0.75 * BETA)).clamp(SHRINK, 1.0)
+        (SAFETY / err.powf(0.2 - 0.75 * BETA)).clamp(SHRINK, 1.0)
     }
 }
 
 /// First step of a segment that starts with an approaching point, in units
-/// of √T at the tolerance 10⁻⁵ (T the point's time scale, law.rs); at
-/// another tolerance it scales as the step of the pair's order,
-/// (tol/10⁻⁵)^(1/(p̂+1)) in x = √t.
+/// of √T at the tolerance 10⁻⁵ (T the point's time scale, law.rs).
 const ONSET_STEP: f64 = 0.3;
 
 /// A switch landed on within this fraction of the step it was found in
 /// makes no progress if it is one of a run of such switches
 /// (see `standstill` in the loop).
 const CRAWL: f64 = 1e-5;
+
+/// Right-hand-side evaluations of one step (Dormand–Prince, first same as
+/// last): the step limit counts this many settling evaluations as a step.
+const STAGES: usize = 6;
 
 /// An expanding point that lets go within this many of the controller's
 /// next steps (at its present rate) ends the present segment: the rest of
@@ -106,30 +103,21 @@ impl Integrator {
         self.constraints_dirty = true;
         self.settle();
         let mut rk = std::mem::take(&mut self.rk);
-        let result = if self.low_order {
-            rk.resize::<Bs32>(self.layout.len());
-            self.step_loop::<Bs32>(&mut rk, max_steps, out)
-        } else {
-            rk.resize::<Dp54>(self.layout.len());
-            self.step_loop::<Dp54>(&mut rk, max_steps, out)
-        };
+        rk.resize(self.layout.len());
+        let result = self.step_loop(&mut rk, max_steps, out);
         self.rk = rk;
         result
     }
 
-    /// The stepping loop with the pair `P`. The step limit counts the
-    /// pair's evaluations per step (first same as last) of settling as
-    /// one step.
-    fn step_loop<P: Pair>(
+    fn step_loop(
         &mut self,
         rk: &mut Rk,
         max_steps: usize,
         out: &mut ImpactOutcome,
     ) -> Result<StopReason, ImpactError> {
-        let evaluations = P::STAGES - 1;
-        let mut h = self.begin_segment::<P>(rk, None);
+        let mut h = self.begin_segment(rk, None);
         let mut attempts = 0usize;
-        let mut control = Controller::new::<P>();
+        let mut control = Controller::default();
         // free flights since the last step: each one closes a gap, so more
         // than one per point without a step in between is a loop that makes
         // no progress (a point that closes but does not load)
@@ -153,18 +141,18 @@ impl Integrator {
                 }
                 flights += 1;
                 if flights > self.layout.contacts + 2
-                    || attempts + self.settling / evaluations > max_steps
+                    || attempts + self.settling / STAGES > max_steps
                 {
                     return Err(ImpactError::StepLimit { steps: out.steps });
                 }
                 self.settle();
-                h = self.begin_segment::<P>(rk, None);
+                h = self.begin_segment(rk, None);
                 continue;
             }
             attempts += 1;
             // settling the modes at switches costs evaluations too; a set of
             // modes that keeps cycling would otherwise spend them unbounded
-            if attempts + self.settling / evaluations > max_steps {
+            if attempts + self.settling / STAGES > max_steps {
                 return Err(ImpactError::StepLimit { steps: out.steps });
             }
             if let Variable::End { sigma, .. } = self.clock.variable {
@@ -172,7 +160,7 @@ impl Integrator {
             }
             rk.y0.copy_from_slice(&self.y);
             flights = 0;
-            let err = self.rk_step::<P>(rk, h);
+            let err = self.rk_step(rk, h);
             if err.is_nan() || err > 1.0 {
                 out.rejected_steps += 1;
                 if err.is_nan() && matches!(self.clock.variable, Variable::End { .. }) {
@@ -214,7 +202,7 @@ impl Integrator {
                 if !matches!(self.clock.variable, Variable::End { .. }) {
                     self.pace = next;
                 }
-                h = self.begin_segment::<P>(rk, Some(self.pace));
+                h = self.begin_segment(rk, Some(self.pace));
                 continue;
             }
             self.y.copy_from_slice(&rk.y1);
@@ -229,7 +217,7 @@ impl Integrator {
                     // expanding point that is as good as spent
                     self.let_go(point);
                     self.settle();
-                    h = self.begin_segment::<P>(rk, Some(self.pace));
+                    h = self.begin_segment(rk, Some(self.pace));
                 }
             } else {
                 self.pace = next;
@@ -290,7 +278,7 @@ impl Integrator {
     /// x = σ₀ − √q when an expanding point lets go within the next step; else
     /// x = t − t₀ with the step `next` (s) the controller proposed, or a
     /// hundredth of the impact's time scale.
-    fn begin_segment<P: Pair>(&mut self, rk: &mut Rk, next: Option<f64>) -> f64 {
+    fn begin_segment(&mut self, rk: &mut Rk, next: Option<f64>) -> f64 {
         rk.fresh = false;
         let next = next.unwrap_or(0.01 * self.scales.time);
         self.pace = next;
@@ -299,7 +287,7 @@ impl Integrator {
                 variable: Variable::Root,
                 x: 0.0,
             };
-            return ONSET_STEP * (t * (self.tolerance / 1e-5).powf(2.0 * P::EXPONENT)).sqrt();
+            return ONSET_STEP * (t * (self.tolerance / 1e-5).powf(0.4)).sqrt();
         }
         match self.ending_point(next, None) {
             Some(end) => self.begin_end_segment(rk, end),
