@@ -347,8 +347,8 @@ fn measure(class: &Class, solver: &mut ImpactSolver, s: &ImpactSettings) -> Meas
 /// the converged runs, the table or criterion, so that `valgrind
 /// --tool=callgrind` on the bench binary counts the resolver alone (the
 /// leaning trains, `leaning20` and `domino20`, are built rather than
-/// read). Prints the class's accepted steps and a hash of the outcomes'
-/// bits.
+/// read). Prints the class's accepted and rejected steps, its settling
+/// evaluations and a hash of the outcomes' bits.
 fn profile(name: &str) {
     let file = match name {
         "leaning20" | "domino20" => "",
@@ -389,13 +389,15 @@ fn profile(name: &str) {
         ..base
     };
     let mut solver = ImpactSolver::new();
-    let mut steps = 0;
+    let (mut steps, mut rejected, mut settling) = (0, 0, 0);
     let mut bits = Fnv::default();
     for _ in 0..repeat {
         for (bodies, contacts) in &impacts {
             match solver.solve(bodies, contacts, &s) {
                 Ok(out) => {
                     steps += out.steps;
+                    rejected += out.rejected_steps;
+                    settling += out.settling_evaluations;
                     bits.outcome(&out);
                 }
                 Err(e) => bits.word(format!("{e:?}").len() as u64),
@@ -403,7 +405,8 @@ fn profile(name: &str) {
         }
     }
     println!(
-        "{name}: {} impacts x {repeat}, {steps} steps, outcome bits {:016x}",
+        "{name}: {} impacts x {repeat}, {steps} steps, {rejected} rejected, \
+         {settling} settling evaluations, outcome bits {:016x}",
         impacts.len(),
         bits.0
     );
