@@ -96,14 +96,20 @@ impl Rk {
             r2[j] = diff;
             r3[j] = first;
             r4[j] = diff - h * self.k[6][j] - first;
-            let mut d = 0.0;
-            for (s, w) in D.iter().enumerate() {
-                if *w != 0.0 {
-                    d += w * self.k[s][j];
-                }
-            }
-            r5[j] = h * d;
         }
+        // r₅ = h Σ_s d_s k_s over the nonzero weights (d₂ = 0), in the
+        // order of s
+        let k = &self.k;
+        let nonzero = [0, 2, 3, 4, 5, 6];
+        debug_assert!(D[1] == 0.0);
+        let n = r5.len();
+        combine_slices(
+            r5,
+            None,
+            nonzero.map(|s| &k[s][..n]),
+            nonzero.map(|s| D[s]),
+            h,
+        );
         self.dense_ready = true;
     }
 }
@@ -150,6 +156,19 @@ fn combine<const S: usize>(
     let n = out.len();
     let ks: [&[f64]; S] = std::array::from_fn(|l| &k[l][..n]);
     let w: [f64; S] = std::array::from_fn(|l| w[l]);
+    combine_slices(out, y0, ks, w, h);
+}
+
+/// [`combine`] over the given terms (each of `out`'s length).
+#[inline(always)]
+fn combine_slices<const S: usize>(
+    out: &mut [f64],
+    y0: Option<&[f64]>,
+    ks: [&[f64]; S],
+    w: [f64; S],
+    h: f64,
+) {
+    let n = out.len();
     let sum = |j: usize| {
         let mut o = 0.0;
         for l in 0..S {
