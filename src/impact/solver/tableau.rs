@@ -101,7 +101,7 @@ impl Rk {
         // order of s
         let k = &self.k;
         let nonzero = [0, 2, 3, 4, 5, 6];
-        debug_assert!(D[1] == 0.0);
+        const { assert!(D[1] == 0.0) };
         let n = r5.len();
         combine_slices(
             r5,
