@@ -347,7 +347,8 @@ fn measure(class: &Class, solver: &mut ImpactSolver, s: &ImpactSettings) -> Meas
 /// the converged runs, the table or criterion, so that `valgrind
 /// --tool=callgrind` on the bench binary counts the resolver alone (the
 /// leaning trains, `leaning20` and `domino20`, are built rather than
-/// read). Prints the class's accepted steps.
+/// read). Prints the class's accepted and rejected steps, its settling
+/// evaluations and a hash of the outcomes' bits.
 fn profile(name: &str) {
     let file = match name {
         "leaning20" | "domino20" => "",
@@ -388,18 +389,61 @@ fn profile(name: &str) {
         ..base
     };
     let mut solver = ImpactSolver::new();
-    let mut steps = 0;
+    let (mut steps, mut rejected, mut settling) = (0, 0, 0);
+    let mut bits = Fnv::default();
     for _ in 0..repeat {
         for (bodies, contacts) in &impacts {
-            if let Ok(out) = solver.solve(bodies, contacts, &s) {
-                steps += out.steps;
+            match solver.solve(bodies, contacts, &s) {
+                Ok(out) => {
+                    steps += out.steps;
+                    rejected += out.rejected_steps;
+                    settling += out.settling_evaluations;
+                    bits.outcome(&out);
+                }
+                Err(e) => bits.word(format!("{e:?}").len() as u64),
             }
         }
     }
     println!(
-        "{name}: {} impacts x {repeat}, {steps} steps",
-        impacts.len()
+        "{name}: {} impacts x {repeat}, {steps} steps, {rejected} rejected, \
+         {settling} settling evaluations, outcome bits {:016x}",
+        impacts.len(),
+        bits.0
     );
+}
+
+/// FNV-1a over the outcomes' bits (velocities, impulses, steps), so that
+/// a change meant to keep every result to the bit can be checked with
+/// `IMPACT_PROFILE` on the builds before and after.
+struct Fnv(u64);
+
+impl Default for Fnv {
+    fn default() -> Self {
+        Fnv(0xcbf2_9ce4_8422_2325)
+    }
+}
+
+impl Fnv {
+    fn word(&mut self, w: u64) {
+        for byte in w.to_le_bytes() {
+            self.0 = (self.0 ^ u64::from(byte)).wrapping_mul(0x0100_0000_01b3);
+        }
+    }
+
+    fn outcome(&mut self, out: &topple::impact::ImpactOutcome) {
+        for b in &out.bodies {
+            for v in [b.velocity[0], b.velocity[1], b.angular_velocity] {
+                self.word(v.to_bits());
+            }
+        }
+        for c in &out.contacts {
+            self.word(c.normal_impulse.to_bits());
+            self.word(c.tangent_impulse.to_bits());
+        }
+        self.word(out.steps as u64);
+        self.word(out.rejected_steps as u64);
+        self.word(out.settling_evaluations as u64);
+    }
 }
 
 fn bench(c: &mut Criterion) {

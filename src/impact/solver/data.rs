@@ -181,6 +181,37 @@ pub(super) fn push_with(
     pb[2] += ib * f * axis.arm_b;
 }
 
+/// [`push_with`] on the accelerations as [ax, ay, α] per body slot (one
+/// bounds check per body; the same operations).
+#[inline]
+pub(super) fn push_slots(
+    inverse: [f64; 4],
+    a: usize,
+    b: usize,
+    axis: &Axis,
+    f: f64,
+    acc: &mut [[f64; 3]],
+) {
+    let [ma, ia, mb, ib] = inverse;
+    let pa = &mut acc[a];
+    pa[0] -= ma * f * axis.dir[0];
+    pa[1] -= ma * f * axis.dir[1];
+    pa[2] -= ia * f * axis.arm_a;
+    let pb = &mut acc[b];
+    pb[0] += mb * f * axis.dir[0];
+    pb[1] += mb * f * axis.dir[1];
+    pb[2] += ib * f * axis.arm_b;
+}
+
+/// [`rate`] on the velocities as [vx, vy, ω] per body slot (one bounds
+/// check per body; the same operations).
+#[inline]
+pub(super) fn slot_rate(v: &[[f64; 3]], a: usize, b: usize, axis: &Axis) -> f64 {
+    let (va, vb) = (&v[a], &v[b]);
+    axis.dir[0] * (vb[0] - va[0]) + axis.dir[1] * (vb[1] - va[1]) + vb[2] * axis.arm_b
+        - va[2] * axis.arm_a
+}
+
 /// Relative rate along `axis` of body `b` against body `a` in the velocities
 /// (or accelerations) `v`: dir·(v_b − v_a) + ω_b arm_b − ω_a arm_a.
 #[inline]

@@ -222,6 +222,8 @@ pub(crate) struct Integrator {
     tangents: Vec<Axis>,
     probe_state: Vec<f64>,
     probe_slope: Vec<f64>,
+    /// δ̇ of every point at the last evaluation (rhs.rs, for its probe).
+    rates: Vec<f64>,
     /// `probe_slope` holds dy/dt at `y` with the present modes: the last
     /// settling ended on a pass that changed nothing (or `ending_point`
     /// evaluated there), so the next step's first stage is a copy of it.
@@ -254,6 +256,7 @@ impl Integrator {
         let len = self.layout.len();
         self.probe_state.resize(len, 0.0);
         self.probe_slope.resize(len, 0.0);
+        self.rates.resize(self.layout.contacts, 0.0);
         out.kinetic_energy_before = bodies.iter().map(Body::kinetic_energy).sum();
         out.steps = 0;
         out.rejected_steps = 0;

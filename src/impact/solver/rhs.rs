@@ -20,7 +20,7 @@
 //! notes every trial point where a mode's own condition fails, and the
 //! event stage (events.rs) locates the switch on the step's interpolant.
 
-use super::data::{normal_rate, push_with, rate, PatchMode, PointMode};
+use super::data::{normal_rate, push_slots, rate, slot_rate, PatchMode, PointMode};
 use super::Integrator;
 
 impl Integrator {
@@ -29,7 +29,7 @@ impl Integrator {
     #[inline]
     pub(super) fn onset_matters(&self, i: usize) -> bool {
         let p = self.rows[i].patch;
-        self.patch_modes[p] == PatchMode::Idle && !self.patches[p].frictionless()
+        matches!(self.patch_modes[p], PatchMode::Idle) && !self.patches[p].frictionless()
     }
 
     /// Whether point `i`, touching with no compression (q = 0) at state
@@ -63,9 +63,11 @@ impl Integrator {
         let (acc, rest) = dy.split_at_mut(3 * lay.bodies);
         acc.fill(0.0);
         // 1. normal forces, with the friction of sliding patches
-        for (i, (row, point)) in self.rows.iter().zip(self.points.iter_mut()).enumerate() {
+        let n = lay.contacts;
+        let qs = &y[lay.q(0)..lay.q(0) + n];
+        let (slots, _) = acc.as_chunks_mut::<3>();
+        for ((row, point), &q) in self.rows.iter().zip(self.points.iter_mut()).zip(qs) {
             point.held_force = 0.0;
-            let q = y[lay.q(i)];
             let f = match point.mode {
                 PointMode::Compress if q > 0.0 => row.law.force(q),
                 PointMode::Expand => row.law.force(q),
@@ -73,7 +75,7 @@ impl Integrator {
             };
             point.force = f;
             if f != 0.0 {
-                push_with(row.inverse, row.a, row.b, &row.drive, f, acc);
+                push_slots(row.inverse, row.a, row.b, &row.drive, f, slots);
             }
         }
         // 2. constraint forces
@@ -83,40 +85,45 @@ impl Integrator {
             self.stuck_loads();
         }
         // 3. compressions and impulses
-        let n = lay.contacts;
         let (dq, rest) = rest.split_at_mut(n);
         let (dpn, rest) = rest.split_at_mut(n);
         let (dpt, time) = rest.split_at_mut(n);
         time[0] = 1.0;
-        for i in 0..n {
-            let row = &self.rows[i];
-            let point = &self.points[i];
-            let rate = normal_rate(row, y);
+        let (velocities, _) = y[..3 * lay.bodies].as_chunks::<3>();
+        let rates = &mut self.rates[..n];
+        let outputs = dq.iter_mut().zip(dpn.iter_mut()).zip(dpt.iter_mut());
+        let inputs = self.rows.iter().zip(&self.points).zip(rates.iter_mut());
+        for (((row, point), rate_out), ((dq, dpn), dpt)) in inputs.zip(outputs) {
+            let rate = slot_rate(velocities, row.a, row.b, &row.normal);
+            *rate_out = rate;
             let normal = point.force + point.held_force;
-            dq[i] = match point.mode {
+            *dq = match point.mode {
                 PointMode::Held => 0.0,
                 PointMode::Expand => row.law.compression_rate(rate, true),
                 PointMode::Compress => -rate,
             };
-            dpn[i] = normal;
-            dpt[i] = if self.patch_modes[row.patch] == PatchMode::Stick {
+            *dpn = normal;
+            *dpt = match self.patch_modes[row.patch] {
                 // shared in proportion to the load, or equally while the
                 // patch carries none (its rows are identical, so any share
                 // books the force the bodies received)
-                let load = &self.patch_states[row.patch];
-                if load.normal > 0.0 {
-                    load.friction * normal / load.normal
-                } else {
-                    load.friction / self.patches[row.patch].count as f64
+                PatchMode::Stick => {
+                    let load = &self.patch_states[row.patch];
+                    if load.normal > 0.0 {
+                        load.friction * normal / load.normal
+                    } else {
+                        load.friction / self.patches[row.patch].count as f64
+                    }
                 }
-            } else {
-                row.slide * normal
+                _ => row.slide * normal,
             };
-            if probe {
-                self.probe_point(i, y[lay.q(i)], rate, y[lay.pn(i)]);
-            }
         }
         if probe {
+            let pns = &y[lay.pn(0)..lay.pn(0) + n];
+            for (i, (&q, &pn)) in qs.iter().zip(pns).enumerate() {
+                let rate = self.rates[i];
+                self.probe_point(i, q, rate, pn);
+            }
             self.probe_patches(y);
         }
     }
@@ -138,7 +145,7 @@ impl Integrator {
     /// by μ_s N).
     fn stuck_loads(&mut self) {
         for (p, patch) in self.patches.iter().enumerate() {
-            if self.patch_modes[p] == PatchMode::Stick {
+            if matches!(self.patch_modes[p], PatchMode::Stick) {
                 let members = &self.members[patch.first..patch.first + patch.count];
                 self.patch_states[p].normal = members
                     .iter()
@@ -186,7 +193,8 @@ impl Integrator {
             let fails = match self.patch_modes[p] {
                 PatchMode::Idle => false,
                 PatchMode::Slide(s) => {
-                    self.patch_loaded(p) && s * rate(y, patch.a, patch.b, &patch.tangent) < -thr
+                    // the slip's rate first: the cheaper of two pure conditions
+                    s * rate(y, patch.a, patch.b, &patch.tangent) < -thr && self.patch_loaded(p)
                 }
                 PatchMode::Stick => {
                     let load = &self.patch_states[p];

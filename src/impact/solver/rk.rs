@@ -92,22 +92,20 @@ impl Integrator {
         let lay = self.layout;
         let core = lay.q(lay.contacts);
         error_estimate(&mut rk.err[..core], &rk.k, h);
-        let err = |j: usize| rk.err[j];
         let v = self.scales.velocity;
         let mut worst = 0.0f64;
-        for (b, slot) in self.bodies.iter().enumerate() {
+        let (velocities, _) = rk.err[..3 * lay.bodies].as_chunks::<3>();
+        for (slot, e) in self.bodies.iter().zip(velocities) {
             if slot.inv_mass == 0.0 {
                 continue;
             }
-            let e = err(3 * b)
-                .abs()
-                .max(err(3 * b + 1).abs())
-                .max(err(3 * b + 2).abs() * slot.gyration);
+            let e = e[0].abs().max(e[1].abs()).max(e[2].abs() * slot.gyration);
             worst = worst.max(e / v);
         }
-        for (i, row) in self.rows.iter().enumerate() {
+        let compressions = &rk.err[lay.q(0)..core];
+        for (row, e) in self.rows.iter().zip(compressions) {
             if row.movable {
-                worst = worst.max(err(lay.q(i)).abs() / row.q_scale);
+                worst = worst.max(e.abs() / row.q_scale);
             }
         }
         if rk.y1.iter().all(|x| x.is_finite()) {

@@ -96,50 +96,98 @@ impl Rk {
             r2[j] = diff;
             r3[j] = first;
             r4[j] = diff - h * self.k[6][j] - first;
-            let mut d = 0.0;
-            for (s, w) in D.iter().enumerate() {
-                if *w != 0.0 {
-                    d += w * self.k[s][j];
-                }
-            }
-            r5[j] = h * d;
         }
+        // r₅ = h Σ_s d_s k_s over the nonzero weights (d₂ = 0), in the
+        // order of s
+        let k = &self.k;
+        let nonzero = [0, 2, 3, 4, 5, 6];
+        const { assert!(D[1] == 0.0) };
+        let n = r5.len();
+        combine_slices(
+            r5,
+            None,
+            nonzero.map(|s| &k[s][..n]),
+            nonzero.map(|s| D[s]),
+            h,
+        );
         self.dense_ready = true;
     }
 }
 
 /// y₀ + h Σ_l a_sl k_l over the components of `out`.
 ///
-/// Summed stage by stage over contiguous slices (so that the loops
-/// vectorise), each component in the order l = 0, 1, …, s − 1 from 0.0:
-/// the same operations, in the same order, as a sum per component.
+/// Each component is summed in the order l = 0, 1, …, s − 1 from 0.0 (the
+/// zero coefficient included), then y₀ + h · sum: the same operations in
+/// the same order as a sum per component, fused into one pass over the
+/// components with the sum kept in a register (the stage count is a
+/// constant of each pass, so the terms unroll and the pass vectorises).
 #[inline]
 pub(super) fn stage_state(out: &mut [f64], y0: &[f64], k: &[Vec<f64>; 7], s: usize, h: f64) {
-    let n = out.len();
-    out.fill(0.0);
-    for (kl, &a) in k.iter().zip(&A[s]).take(s) {
-        for (o, &v) in out.iter_mut().zip(&kl[..n]) {
-            *o += a * v;
-        }
-    }
-    for (o, &y) in out.iter_mut().zip(&y0[..n]) {
-        *o = y + h * *o;
+    let a = &A[s];
+    match s {
+        1 => combine::<1>(out, Some(y0), k, a, h),
+        2 => combine::<2>(out, Some(y0), k, a, h),
+        3 => combine::<3>(out, Some(y0), k, a, h),
+        4 => combine::<4>(out, Some(y0), k, a, h),
+        5 => combine::<5>(out, Some(y0), k, a, h),
+        6 => combine::<6>(out, Some(y0), k, a, h),
+        _ => unreachable!("stage {s} of seven"),
     }
 }
 
 /// h Σ_s (b_s − b̂_s) k_s over the components of `out` (the local error
-/// estimate), summed as [`stage_state`] sums.
+/// estimate), summed per component in the order s = 0, …, 6 from 0.0, then
+/// times h.
 #[inline]
 pub(super) fn error_estimate(out: &mut [f64], k: &[Vec<f64>; 7], h: f64) {
+    combine::<7>(out, None, k, &E, h);
+}
+
+/// out_j = y0_j + h Σ_{l<S} w_l k_l,j, or h · Σ without `y0` (the sum from
+/// 0.0, in the order of l).
+#[inline(always)]
+fn combine<const S: usize>(
+    out: &mut [f64],
+    y0: Option<&[f64]>,
+    k: &[Vec<f64>; 7],
+    w: &[f64],
+    h: f64,
+) {
     let n = out.len();
-    out.fill(0.0);
-    for (ks, &w) in k.iter().zip(&E) {
-        for (o, &v) in out.iter_mut().zip(&ks[..n]) {
-            *o += w * v;
+    let ks: [&[f64]; S] = std::array::from_fn(|l| &k[l][..n]);
+    let w: [f64; S] = std::array::from_fn(|l| w[l]);
+    combine_slices(out, y0, ks, w, h);
+}
+
+/// [`combine`] over the given terms (each of `out`'s length).
+#[inline(always)]
+fn combine_slices<const S: usize>(
+    out: &mut [f64],
+    y0: Option<&[f64]>,
+    ks: [&[f64]; S],
+    w: [f64; S],
+    h: f64,
+) {
+    let n = out.len();
+    let sum = |j: usize| {
+        let mut o = 0.0;
+        for l in 0..S {
+            o += w[l] * ks[l][j];
         }
-    }
-    for o in out.iter_mut() {
-        *o *= h;
+        o
+    };
+    match y0 {
+        Some(y0) => {
+            let y0 = &y0[..n];
+            for (j, (o, &y)) in out.iter_mut().zip(y0).enumerate() {
+                *o = y + h * sum(j);
+            }
+        }
+        None => {
+            for (j, o) in out.iter_mut().enumerate() {
+                *o = sum(j) * h;
+            }
+        }
     }
 }
 
