@@ -425,7 +425,8 @@ impl GroupSolver {
         let elastic = contacts
             .iter()
             .any(|c| c.material.restitution > PROBE_MAX_RESTITUTION);
-        if !policy.probe_large_groups || !self.large || cap == 0 || !(rest > 0.0) || elastic {
+        let no_rest = rest.is_nan() || rest <= 0.0;
+        if !policy.probe_large_groups || !self.large || cap == 0 || no_rest || elastic {
             return None;
         }
         let v0 = fastest_approach(bodies, contacts);
