@@ -975,7 +975,20 @@ mod tests {
             solver.last_work()
         );
         assert_eq!(probed.bodies, capped.bodies);
+        // the plastic outcome on its own: no contact approaching faster
+        // than the rest speed, no energy created, every impulse in its
+        // friction cone (|P_t| ≤ μ_s P_n, P_n ≥ 0)
+        let left = approach_left(&bodies, &contacts, &probed);
+        assert!(left <= settings.rest_speed, "{left}");
         assert!(!probed.gains_energy());
+        for (c, p) in contacts.iter().zip(&probed.contacts) {
+            let mu = c.material.stick_friction.max(c.material.friction);
+            assert!(p.normal_impulse >= 0.0, "{p:?}");
+            assert!(
+                p.tangent_impulse.abs() <= mu * p.normal_impulse * (1.0 + 1e-12),
+                "{p:?}"
+            );
+        }
     }
 
     /// Large groups whose law ends within the cap and whose contacts give
