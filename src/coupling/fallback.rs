@@ -71,9 +71,10 @@ pub struct FallbackPolicy {
     /// v₀ has halved, within the cap over the halvings it must make before
     /// the impact ends (log₂(v₀ / v_r), v_r the impact's rest speed); a
     /// group that does not halve it in time cannot end within its cap at
-    /// that pace and ends plastic there, at a fraction of the cap's cost
-    /// (docs/bevy.md, "Large groups end plastic"). `false`: every large
-    /// group spends its cap on the law first.
+    /// that pace and ends plastic there, at a fraction of the cap's cost;
+    /// one that has goes on to the law's attempts with what is left of its
+    /// cap (docs/bevy.md, "Bounded frames", "The progress probe"). `false`:
+    /// every large group spends its cap on the law first.
     #[serde(default = "default_true")]
     pub probe_large_groups: bool,
 }
@@ -364,7 +365,7 @@ impl GroupSolver {
         if let Some(probe) = self.probe_settings(bodies, contacts, settings, policy, cap) {
             // a group whose law does not halve its fastest approach within
             // its share of the cap cannot end within the cap at that pace
-            if left > 0 && !self.probe(bodies, contacts, &probe, &mut left, out)? {
+            if left > 0 && !self.probe(bodies, contacts, &probe, &mut left, &mut cap, out)? {
                 cap = 0;
             }
             left = left.saturating_sub(margin);
@@ -441,15 +442,17 @@ impl GroupSolver {
     }
 
     /// Runs the progress probe `probe` within what is `left` of the budget
-    /// and charges its work (not the cap: a group that goes on to its
-    /// attempts is stepped as without the probe). Whether the fastest
-    /// approach halved in time; errors only for invalid input.
+    /// and charges its steps to the budget and to the large group's `cap`
+    /// (the group's LZB attempts, the probe among them, spend at most its
+    /// cap). Whether the fastest approach halved in time; errors only for
+    /// invalid input.
     fn probe(
         &mut self,
         bodies: &[Body],
         contacts: &[Contact],
         probe: &ImpactSettings,
         left: &mut usize,
+        cap: &mut usize,
         out: &mut ImpactOutcome,
     ) -> Result<bool, ImpactError> {
         let within = ImpactSettings {
@@ -458,8 +461,7 @@ impl GroupSolver {
         };
         Self::fresh(out);
         let result = self.lzb.solve_into(bodies, contacts, &within, out);
-        let mut uncapped = usize::MAX;
-        self.charge(out, contacts.len().max(1) as u64, left, &mut uncapped);
+        self.charge(out, contacts.len().max(1) as u64, left, cap);
         match result {
             Ok(()) => Ok(true),
             Err(ImpactError::StepLimit { .. } | ImpactError::NonFinite { .. }) => Ok(false),
@@ -1040,6 +1042,53 @@ mod tests {
             );
             assert!(!probed.gains_energy(), "{len} {e}");
         }
+    }
+
+    /// A large group that passes the probe but whose law needs more than
+    /// its cap (a 13-ball star with e = 0.3, 3,420 units unbounded) spends
+    /// at most the cap on the probe and the attempt together, then ends
+    /// plastic, creating no energy.
+    #[test]
+    fn the_probe_is_paid_from_the_cap() {
+        let (bodies, contacts) = star(3, 0.3);
+        let mut solver = GroupSolver::default();
+        let mut out = ImpactOutcome::default();
+        let unbounded = FallbackPolicy {
+            large_group: None,
+            ..budgeted()
+        };
+        let how = solver
+            .solve_into(
+                &bodies,
+                &contacts,
+                &at_rest_fraction(),
+                &unbounded,
+                &mut out,
+            )
+            .unwrap();
+        assert_eq!(how, Resolution::Lzb);
+        let cap = LargeGroup::DEFAULT.work;
+        assert!(solver.last_work() > cap, "{}", solver.last_work());
+        let how = solver
+            .solve_into(
+                &bodies,
+                &contacts,
+                &at_rest_fraction(),
+                &budgeted(),
+                &mut out,
+            )
+            .unwrap();
+        assert_eq!(how, Resolution::Plastic);
+        // the attempt after the probe: the cap less the probe's steps,
+        // overshot by at most its last step and two settlings
+        let per_step = contacts.len() as u64;
+        let settle = (4 + 4 * per_step) / SETTLING_PER_STEP as u64 + 1;
+        assert!(
+            solver.last_work() <= cap + (1 + 2 * settle) * per_step,
+            "{}",
+            solver.last_work()
+        );
+        assert!(!out.gains_energy());
     }
 
     /// An elastic star hands the striking ball's approach on undiminished

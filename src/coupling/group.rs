@@ -200,10 +200,10 @@ impl ImpactGroups {
     ///
     /// Without the progress probe the attempts need `floor(left/points) ≥
     /// cap + 2·margin` (`cap = work/points` steps). The probe
-    /// ([`super::FallbackPolicy::probe_large_groups`]) comes first: its
-    /// limit is at most half the cap (at least two halvings), it may take
-    /// a margin past it, and a margin is kept back after it, so
-    /// `floor(left/points) ≥ cap + cap/2 + 5·margin`.
+    /// ([`super::FallbackPolicy::probe_large_groups`]) comes first, its
+    /// limit at most half the cap (at least two halvings) and its steps
+    /// taken from the cap as from the budget, with one more margin kept
+    /// back after it: `floor(left/points) ≥ cap + 3·margin`.
     fn cap_binds(&self, contacts: usize, left: u64) -> bool {
         let Some(large) = self.large_group else {
             return false;
@@ -214,7 +214,7 @@ impl ImpactGroups {
             super::fallback::budget_margin(contacts),
         );
         let needed = if self.probe {
-            cap + cap / 2 + 5 * margin
+            cap + 3 * margin
         } else {
             cap + 2 * margin
         };
@@ -298,10 +298,10 @@ impl ImpactGroups {
     /// steps, less what the first attempt took for the second, each after
     /// a margin): with `floor(budget/points) ≥ cap + 2·margin` the cap is
     /// the smaller under either budget, whatever the outcome (with the
-    /// progress probe before them, `cap + cap/2 + 5·margin`: the probe's
-    /// limit, at most half the cap, bounds it, and one more margin is kept
-    /// after it; a large group that finished by the law needs one margin
-    /// more than a small one, for the same reason). The groups of
+    /// progress probe before them, whose steps the cap pays too, `cap +
+    /// 3·margin`: one more margin is kept after the probe; a large group
+    /// that finished by the law needs one margin more than a small one, for
+    /// the same reason). The groups of
     /// one call share the budget, each checked with what the groups before
     /// it left.
     ///
