@@ -66,6 +66,21 @@ pub struct FallbackPolicy {
     /// [`LargeGroup::DEFAULT`].
     #[serde(default = "LargeGroup::default_some")]
     pub large_group: Option<LargeGroup>,
+    /// Whether a large group's law is first probed for its progress
+    /// (default `true`): the law is run until the group's fastest approach
+    /// v₀ has halved, within the cap over the halvings it must make before
+    /// the impact ends (log₂(v₀ / v_r), v_r the impact's rest speed); a
+    /// group that does not halve it in time cannot end within its cap at
+    /// that pace and ends plastic there, at a fraction of the cap's cost;
+    /// one that has goes on to the law's attempts with what is left of its
+    /// cap (docs/bevy.md, "Bounded frames", "The progress probe"). `false`:
+    /// every large group spends its cap on the law first.
+    #[serde(default = "default_true")]
+    pub probe_large_groups: bool,
+}
+
+fn default_true() -> bool {
+    true
 }
 
 impl Default for FallbackPolicy {
@@ -75,6 +90,7 @@ impl Default for FallbackPolicy {
             max_steps: 200_000,
             max_work: None,
             large_group: Some(LargeGroup::DEFAULT),
+            probe_large_groups: true,
         }
     }
 }
@@ -239,6 +255,45 @@ pub(super) fn budget_margin(contacts: usize) -> u64 {
     2 + 2 * (4 + 4 * contacts as u64) / SETTLING_PER_STEP as u64
 }
 
+/// A large group is probed only if no contact of it has a restitution above
+/// this: each load cycle of such a contact gives back at most half the
+/// approach it stopped, so the group's fastest approach falls by halves as
+/// its bounces go on. A more elastic group can hand its approach on
+/// undiminished (a cluster of elastic balls: a Newton's cradle with
+/// branches), so that the approach falls only at the impact's end and
+/// the pace of its first halving says nothing.
+const PROBE_MAX_RESTITUTION: f64 = 0.5;
+
+/// A large group is probed only if the law must halve its fastest approach
+/// at least this many times before the impact ends (see
+/// [`GroupSolver::probe_limit`]).
+const PROBE_MIN_HALVINGS: f64 = 2.0;
+
+/// The fastest approach speed −n·(v₂ − v₁) at any contact point of an
+/// impact before it (m/s, ≥ 0; the world and fixed bodies move with the
+/// velocity they are given).
+fn fastest_approach(bodies: &[Body], contacts: &[Contact]) -> f64 {
+    let world = bodies.len();
+    let at = |slot: usize, arm: [f64; 2]| {
+        if slot == world {
+            return [0.0, 0.0];
+        }
+        let b = &bodies[slot];
+        [
+            b.velocity[0] - b.angular_velocity * arm[1],
+            b.velocity[1] + b.angular_velocity * arm[0],
+        ]
+    };
+    contacts
+        .iter()
+        .map(|c| {
+            let f = c.frame(bodies);
+            let (va, vb) = (at(f.a, f.arm_a), at(f.b, f.arm_b));
+            -(f.normal[0] * (vb[0] - va[0]) + f.normal[1] * (vb[1] - va[1]))
+        })
+        .fold(0.0, f64::max)
+}
+
 fn unfinished(r: &Result<(), ImpactError>) -> bool {
     matches!(
         r,
@@ -307,6 +362,14 @@ impl GroupSolver {
         let mut left = left.saturating_sub(margin);
         self.large = policy.is_large(bodies.len(), branches(contacts, &mut self.pairs));
         let mut cap = policy.large_cap_steps(self.large, per_step);
+        if let Some(probe) = self.probe_settings(bodies, contacts, settings, policy, cap) {
+            // a group whose law does not halve its fastest approach within
+            // its share of the cap cannot end within the cap at that pace
+            if left > 0 && !self.probe(bodies, contacts, &probe, &mut left, &mut cap, out)? {
+                cap = 0;
+            }
+            left = left.saturating_sub(margin);
+        }
         if left > 0 && cap > 0 {
             let first = ImpactSettings {
                 max_steps: budget.min(settings.max_steps).min(left).min(cap).max(1),
@@ -341,6 +404,69 @@ impl GroupSolver {
         self.plastic.set_rest_speed(settings.rest_speed);
         self.plastic.solve_into(bodies, contacts, out);
         Ok(Resolution::Plastic)
+    }
+
+    /// A large group's progress probe ([`FallbackPolicy::probe_large_groups`]):
+    /// the law on the group until its fastest approach v₀ has halved (the
+    /// impact ended at the rest speed v₀/2: no point approaching faster,
+    /// none storing the energy to rebound faster), within the cap over the
+    /// halvings the law must make before the impact ends at its rest speed
+    /// v_r, log₂(v₀ / v_r). `None` (no probe: the cap alone) when the group
+    /// is not large, the impact has no rest speed to end at, or v₀ < 4 v_r
+    /// (fewer than two halvings: the probe would be the impact).
+    fn probe_settings(
+        &self,
+        bodies: &[Body],
+        contacts: &[Contact],
+        settings: &ImpactSettings,
+        policy: &FallbackPolicy,
+        cap: usize,
+    ) -> Option<ImpactSettings> {
+        let rest = settings.rest_speed;
+        let elastic = contacts
+            .iter()
+            .any(|c| c.material.restitution > PROBE_MAX_RESTITUTION);
+        let no_rest = rest.is_nan() || rest <= 0.0;
+        if !policy.probe_large_groups || !self.large || cap == 0 || no_rest || elastic {
+            return None;
+        }
+        let v0 = fastest_approach(bodies, contacts);
+        let halvings = (v0 / rest).log2();
+        (halvings >= PROBE_MIN_HALVINGS).then(|| ImpactSettings {
+            rest_speed: 0.5 * v0,
+            max_steps: ((cap as f64 / halvings) as usize)
+                .min(settings.max_steps)
+                .max(1),
+            ..*settings
+        })
+    }
+
+    /// Runs the progress probe `probe` within what is `left` of the budget
+    /// and charges its steps to the budget and to the large group's `cap`
+    /// (the group's LZB attempts, the probe among them, spend at most its
+    /// cap). Whether the fastest approach halved in time; errors only for
+    /// invalid input.
+    fn probe(
+        &mut self,
+        bodies: &[Body],
+        contacts: &[Contact],
+        probe: &ImpactSettings,
+        left: &mut usize,
+        cap: &mut usize,
+        out: &mut ImpactOutcome,
+    ) -> Result<bool, ImpactError> {
+        let within = ImpactSettings {
+            max_steps: probe.max_steps.min(*left).max(1),
+            ..*probe
+        };
+        Self::fresh(out);
+        let result = self.lzb.solve_into(bodies, contacts, &within, out);
+        self.charge(out, contacts.len().max(1) as u64, left, cap);
+        match result {
+            Ok(()) => Ok(true),
+            Err(ImpactError::StepLimit { .. } | ImpactError::NonFinite { .. }) => Ok(false),
+            Err(e) => Err(e),
+        }
     }
 
     /// Adds an attempt's steps to the work and takes them from `left` and
@@ -768,6 +894,254 @@ mod tests {
                 (a.kinetic_energy_after - ke0).abs() < 1e-5 * ke0,
                 "{n} balls"
             );
+        }
+    }
+
+    /// A star of `1 + 4·len` equal balls (1 kg, r = 0.05 m, no walls): a
+    /// centre ball and four arms of `len` touching balls along ±x and ±y,
+    /// the far ball of the −x arm driven at 1 m/s into the rest, restitution
+    /// `e` everywhere. The centre touches four balls: a branched group, and
+    /// with two or more balls an arm a large one.
+    fn star(len: usize, e: f64) -> (Vec<Body>, Vec<Contact>) {
+        let m = ContactMaterial::hertz(1e8).with_restitution(e);
+        let mut bodies = vec![Body::new(1.0, 0.001)];
+        let mut contacts = Vec::new();
+        for d in [[1.0, 0.0], [-1.0, 0.0], [0.0, 1.0], [0.0, -1.0]] {
+            let mut previous = 0;
+            for k in 1..=len {
+                let at = [0.1 * k as f64 * d[0], 0.1 * k as f64 * d[1]];
+                let mut ball = Body::new(1.0, 0.001).with_position(at);
+                if d[0] < 0.0 && k == len {
+                    ball = ball.with_velocity([1.0, 0.0]);
+                }
+                bodies.push(ball);
+                let i = bodies.len() - 1;
+                let point = [at[0] - 0.05 * d[0], at[1] - 0.05 * d[1]];
+                contacts.push(Contact::new([Some(previous), Some(i)], point, d, m));
+                previous = i;
+            }
+        }
+        (bodies, contacts)
+    }
+
+    /// The settings of an engine's impact: ended at a hundredth of the
+    /// fastest approach (1 m/s in the stars), as the engines end an impact
+    /// at their rest fraction.
+    fn at_rest_fraction() -> ImpactSettings {
+        ImpactSettings {
+            rest_speed: 1e-2,
+            ..ImpactSettings::adaptive(1e-6)
+        }
+    }
+
+    /// The captured pile landing (15 boxes, 33 points, e = 0.3) does not
+    /// halve its fastest approach within its share of the cap: the probe
+    /// ends it plastic after that share, a fraction of the cap, with the
+    /// same velocities as the plastic solve after the whole cap.
+    #[test]
+    fn a_pile_landing_that_cannot_end_within_its_cap_ends_plastic_at_its_probe() {
+        let (bodies, contacts) = landing();
+        let fastest = fastest_approach(&bodies, &contacts);
+        let settings = ImpactSettings {
+            rest_speed: 1e-2 * fastest,
+            ..ImpactSettings::adaptive(1e-6)
+        };
+        let per_step = contacts.len() as u64;
+        let cap = LargeGroup::DEFAULT.work / per_step;
+        let mut solver = GroupSolver::default();
+        let (mut probed, mut capped) = (ImpactOutcome::default(), ImpactOutcome::default());
+        let how = solver
+            .solve_into(&bodies, &contacts, &settings, &budgeted(), &mut probed)
+            .unwrap();
+        assert_eq!(how, Resolution::Plastic);
+        assert!(solver.last_was_large());
+        let work = solver.last_work();
+        // the probe's limit: the cap over log₂(v₀/v_r) = log₂ 100 halvings,
+        // overshot by at most the last step and two settlings
+        let limit = (cap as f64 / 100f64.log2()) as u64;
+        let settle = (4 + 4 * per_step) / SETTLING_PER_STEP as u64 + 1;
+        assert!(work <= (limit + 1 + 2 * settle) * per_step, "{work}");
+        assert!(work < LargeGroup::DEFAULT.work / 2, "{work}");
+        // without the probe: the whole cap, then the same plastic solve
+        let whole_cap = FallbackPolicy {
+            probe_large_groups: false,
+            ..budgeted()
+        };
+        let how = solver
+            .solve_into(&bodies, &contacts, &settings, &whole_cap, &mut capped)
+            .unwrap();
+        assert_eq!(how, Resolution::Plastic);
+        assert!(
+            solver.last_work() > 3 * work,
+            "{} {work}",
+            solver.last_work()
+        );
+        assert_eq!(probed.bodies, capped.bodies);
+        // the plastic outcome on its own: no contact approaching faster
+        // than the rest speed, no energy created, every impulse in its
+        // friction cone (|P_t| ≤ μ_s P_n, P_n ≥ 0)
+        let left = approach_left(&bodies, &contacts, &probed);
+        assert!(left <= settings.rest_speed, "{left}");
+        assert!(!probed.gains_energy());
+        for (c, p) in contacts.iter().zip(&probed.contacts) {
+            let mu = c.material.stick_friction.max(c.material.friction);
+            assert!(p.normal_impulse >= 0.0, "{p:?}");
+            assert!(
+                p.tangent_impulse.abs() <= mu * p.normal_impulse * (1.0 + 1e-12),
+                "{p:?}"
+            );
+        }
+    }
+
+    /// Large groups whose law ends within the cap and whose contacts give
+    /// back at most half their approach (e ≤ ½) pass the probe and end by
+    /// the law, with the bits of the cap alone; momentum is kept (no walls)
+    /// and no energy created.
+    #[test]
+    fn a_branched_group_that_ends_within_its_cap_passes_the_probe() {
+        let mut solver = GroupSolver::default();
+        let (mut probed, mut capped) = (ImpactOutcome::default(), ImpactOutcome::default());
+        for (len, e) in [(2, 0.0), (2, 0.3), (2, 0.5), (3, 0.0), (3, 0.5)] {
+            let (bodies, contacts) = star(len, e);
+            let how = solver
+                .solve_into(
+                    &bodies,
+                    &contacts,
+                    &at_rest_fraction(),
+                    &budgeted(),
+                    &mut probed,
+                )
+                .unwrap();
+            assert!(solver.last_was_large(), "{len} {e}");
+            let with_probe = solver.last_work();
+            let whole_cap = FallbackPolicy {
+                probe_large_groups: false,
+                ..budgeted()
+            };
+            let without = solver
+                .solve_into(
+                    &bodies,
+                    &contacts,
+                    &at_rest_fraction(),
+                    &whole_cap,
+                    &mut capped,
+                )
+                .unwrap();
+            assert_eq!(
+                (how, without),
+                (Resolution::Lzb, Resolution::Lzb),
+                "{len} {e}"
+            );
+            assert_eq!(probed.bodies, capped.bodies, "{len} {e}");
+            // the probe's work comes on top of the law's
+            assert!(with_probe > solver.last_work(), "{len} {e}");
+            let (p0, p1) = (momentum(&bodies, None), momentum(&bodies, Some(&probed)));
+            assert!(
+                (p1[0] - p0[0]).abs() < 1e-12 && p1[1].abs() < 1e-12,
+                "{len} {e} {p1:?}"
+            );
+            assert!(!probed.gains_energy(), "{len} {e}");
+        }
+    }
+
+    /// A large group that passes the probe but whose law needs more than
+    /// its cap (a 13-ball star with e = 0.3, 3,420 units unbounded) spends
+    /// at most the cap on the probe and the attempt together, then ends
+    /// plastic, creating no energy.
+    #[test]
+    fn the_probe_is_paid_from_the_cap() {
+        let (bodies, contacts) = star(3, 0.3);
+        let mut solver = GroupSolver::default();
+        let mut out = ImpactOutcome::default();
+        let unbounded = FallbackPolicy {
+            large_group: None,
+            ..budgeted()
+        };
+        let how = solver
+            .solve_into(
+                &bodies,
+                &contacts,
+                &at_rest_fraction(),
+                &unbounded,
+                &mut out,
+            )
+            .unwrap();
+        assert_eq!(how, Resolution::Lzb);
+        let cap = LargeGroup::DEFAULT.work;
+        assert!(solver.last_work() > cap, "{}", solver.last_work());
+        let how = solver
+            .solve_into(
+                &bodies,
+                &contacts,
+                &at_rest_fraction(),
+                &budgeted(),
+                &mut out,
+            )
+            .unwrap();
+        assert_eq!(how, Resolution::Plastic);
+        // the attempt after the probe: the cap less the probe's steps,
+        // overshot by at most its last step and two settlings
+        let per_step = contacts.len() as u64;
+        let settle = (4 + 4 * per_step) / SETTLING_PER_STEP as u64 + 1;
+        assert!(
+            solver.last_work() <= cap + (1 + 2 * settle) * per_step,
+            "{}",
+            solver.last_work()
+        );
+        assert!(!out.gains_energy());
+    }
+
+    /// An elastic star hands the striking ball's approach on undiminished
+    /// (a Newton's cradle with branches): its fastest approach falls only
+    /// at the impact's end, so it is not probed; it ends by the law with
+    /// the bits and the work of the cap alone, energy and momentum kept.
+    #[test]
+    fn an_elastic_large_group_is_not_probed() {
+        let mut solver = GroupSolver::default();
+        let (mut probed, mut capped) = (ImpactOutcome::default(), ImpactOutcome::default());
+        for len in [2, 3] {
+            let (bodies, contacts) = star(len, 1.0);
+            let how = solver
+                .solve_into(
+                    &bodies,
+                    &contacts,
+                    &at_rest_fraction(),
+                    &budgeted(),
+                    &mut probed,
+                )
+                .unwrap();
+            let work = solver.last_work();
+            let whole_cap = FallbackPolicy {
+                probe_large_groups: false,
+                ..budgeted()
+            };
+            solver
+                .solve_into(
+                    &bodies,
+                    &contacts,
+                    &at_rest_fraction(),
+                    &whole_cap,
+                    &mut capped,
+                )
+                .unwrap();
+            assert_eq!(how, Resolution::Lzb, "{len}");
+            assert_eq!(
+                (probed.bodies.clone(), work),
+                (capped.bodies.clone(), solver.last_work())
+            );
+            // e = 1: energy is lost only where the impact ends at its rest
+            // speed v_r, each point dropping what it stores below a rebound
+            // of v_r, E ≤ v_r²/(2 W_nn), W_nn = 2/kg for two 1 kg balls
+            // struck centrally
+            let ke0: f64 = bodies.iter().map(Body::kinetic_energy).sum();
+            let lost = ke0 - probed.kinetic_energy_after;
+            let v_r = at_rest_fraction().rest_speed;
+            assert!(
+                lost >= 0.0 && lost <= contacts.len() as f64 * v_r * v_r / 4.0,
+                "{len} {lost}"
+            );
+            let (p0, p1) = (momentum(&bodies, None), momentum(&bodies, Some(&probed)));
+            assert!((p1[0] - p0[0]).abs() < 1e-12, "{len} {p1:?}");
         }
     }
 

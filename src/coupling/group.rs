@@ -155,6 +155,9 @@ pub struct ImpactGroups {
     group_work: Vec<u64>,
     /// The last call's cap on large groups ([`super::FallbackPolicy::large_group`]).
     large_group: Option<super::LargeGroup>,
+    /// Whether the last call probed its large groups
+    /// ([`super::FallbackPolicy::probe_large_groups`]).
+    probe: bool,
 }
 
 #[inline]
@@ -194,22 +197,52 @@ impl ImpactGroups {
     /// A large group of `contacts` points had its LZB attempts bounded by
     /// its cap under the budget `left` as under any larger one
     /// ([`ImpactGroups::same_under`]).
+    ///
+    /// Without the progress probe the attempts need `floor(left/points) ≥
+    /// cap + 2·margin` (`cap = work/points` steps). The probe
+    /// ([`super::FallbackPolicy::probe_large_groups`]) comes first, its
+    /// limit at most half the cap (at least two halvings) and its steps
+    /// taken from the cap as from the budget, with one more margin kept
+    /// back after it: `floor(left/points) ≥ cap + 3·margin`.
     fn cap_binds(&self, contacts: usize, left: u64) -> bool {
         let Some(large) = self.large_group else {
             return false;
         };
         let points = contacts.max(1) as u64;
-        left / points >= large.work / points + 2 * super::fallback::budget_margin(contacts)
+        let (cap, margin) = (
+            large.work / points,
+            super::fallback::budget_margin(contacts),
+        );
+        let needed = if self.probe {
+            cap + 3 * margin
+        } else {
+            cap + 2 * margin
+        };
+        left / points >= needed
+    }
+
+    /// The margins an impact that finished by the law kept back before its
+    /// attempt ([`lzb_fits`]): one, and one more after a large group's
+    /// progress probe.
+    fn margins(&self, report: &ImpactReport) -> u64 {
+        if report.large_group && self.probe {
+            2
+        } else {
+            1
+        }
     }
 }
 
-/// Whether a first LZB attempt that charged `work` on an impact of
-/// `contacts` points takes the same steps under the budget `left`
-/// ([`ImpactGroups::same_under`]): `floor(left/points) ≥ s + 1 + margin`,
-/// `s = work/points`, the margin as the fallback policy keeps it back.
-fn lzb_fits(work: u64, contacts: usize, left: u64) -> bool {
+/// Whether the LZB work `work` of an impact of `contacts` points that
+/// finished by the law's first attempt (after a large group's probe, if it
+/// had one) is done the same under the budget `left`
+/// ([`ImpactGroups::same_under`]): `floor(left/points) ≥ s + 1 +
+/// margins·margin`, `s = work/points` its steps (the probe's and the
+/// attempt's), with the `margins` the fallback policy kept back before the
+/// attempt.
+fn lzb_fits(work: u64, contacts: usize, left: u64, margins: u64) -> bool {
     let points = contacts.max(1) as u64;
-    left / points >= work / points + 1 + super::fallback::budget_margin(contacts)
+    left / points >= work / points + 1 + margins * super::fallback::budget_margin(contacts)
 }
 
 fn find(parent: &mut [usize], mut i: usize) -> usize {
@@ -264,7 +297,11 @@ impl ImpactGroups {
     /// by the smaller of what is left and its cap (`cap = work/points`
     /// steps, less what the first attempt took for the second, each after
     /// a margin): with `floor(budget/points) ≥ cap + 2·margin` the cap is
-    /// the smaller under either budget, whatever the outcome. The groups of
+    /// the smaller under either budget, whatever the outcome (with the
+    /// progress probe before them, whose steps the cap pays too, `cap +
+    /// 3·margin`: one more margin is kept after the probe; a large group
+    /// that finished by the law needs one margin more than a small one, for
+    /// the same reason). The groups of
     /// one call share the budget, each checked with what the groups before
     /// it left.
     ///
@@ -302,8 +339,8 @@ impl ImpactGroups {
                 return true; // the rest sees the same budget
             }
             let capped = report.large_group && self.cap_binds(report.contacts, left);
-            let fits =
-                report.resolution == Resolution::Lzb && lzb_fits(work, report.contacts, left);
+            let fits = report.resolution == Resolution::Lzb
+                && lzb_fits(work, report.contacts, left, self.margins(report));
             if !capped && !fits {
                 return false;
             }
@@ -344,6 +381,7 @@ impl ImpactGroups {
         self.work = 0;
         self.group_work.clear();
         self.large_group = settings.fallback.large_group;
+        self.probe = settings.fallback.probe_large_groups;
         self.find_seeds(bodies, contacts, settings);
         if self.seeds.is_empty() {
             return 0; // the common case: nothing else is done
