@@ -927,6 +927,32 @@ mod tests {
     /// The settings of an engine's impact: ended at a hundredth of the
     /// fastest approach (1 m/s in the stars), as the engines end an impact
     /// at their rest fraction.
+    /// Solves one large group under [`budgeted`] at [`at_rest_fraction`]
+    /// with the progress probe (into `probed`) and with the cap alone (into
+    /// `capped`): (resolution, LZB work) of each.
+    fn probe_and_cap_alone(
+        solver: &mut GroupSolver,
+        bodies: &[Body],
+        contacts: &[Contact],
+        probed: &mut ImpactOutcome,
+        capped: &mut ImpactOutcome,
+    ) -> ((Resolution, u64), (Resolution, u64)) {
+        let settings = at_rest_fraction();
+        let how = solver
+            .solve_into(bodies, contacts, &settings, &budgeted(), probed)
+            .unwrap();
+        assert!(solver.last_was_large());
+        let with_probe = solver.last_work();
+        let whole_cap = FallbackPolicy {
+            probe_large_groups: false,
+            ..budgeted()
+        };
+        let without = solver
+            .solve_into(bodies, contacts, &settings, &whole_cap, capped)
+            .unwrap();
+        ((how, with_probe), (without, solver.last_work()))
+    }
+
     fn at_rest_fraction() -> ImpactSettings {
         ImpactSettings {
             rest_speed: 1e-2,
@@ -1003,30 +1029,8 @@ mod tests {
         let (mut probed, mut capped) = (ImpactOutcome::default(), ImpactOutcome::default());
         for (len, e) in [(2, 0.0), (2, 0.3), (2, 0.5), (3, 0.0), (3, 0.5)] {
             let (bodies, contacts) = star(len, e);
-            let how = solver
-                .solve_into(
-                    &bodies,
-                    &contacts,
-                    &at_rest_fraction(),
-                    &budgeted(),
-                    &mut probed,
-                )
-                .unwrap();
-            assert!(solver.last_was_large(), "{len} {e}");
-            let with_probe = solver.last_work();
-            let whole_cap = FallbackPolicy {
-                probe_large_groups: false,
-                ..budgeted()
-            };
-            let without = solver
-                .solve_into(
-                    &bodies,
-                    &contacts,
-                    &at_rest_fraction(),
-                    &whole_cap,
-                    &mut capped,
-                )
-                .unwrap();
+            let ((how, with_probe), (without, cap_alone)) =
+                probe_and_cap_alone(&mut solver, &bodies, &contacts, &mut probed, &mut capped);
             assert_eq!(
                 (how, without),
                 (Resolution::Lzb, Resolution::Lzb),
@@ -1034,7 +1038,7 @@ mod tests {
             );
             assert_eq!(probed.bodies, capped.bodies, "{len} {e}");
             // the probe's work comes on top of the law's
-            assert!(with_probe > solver.last_work(), "{len} {e}");
+            assert!(with_probe > cap_alone, "{len} {e}");
             let (p0, p1) = (momentum(&bodies, None), momentum(&bodies, Some(&probed)));
             assert!(
                 (p1[0] - p0[0]).abs() < 1e-12 && p1[1].abs() < 1e-12,
@@ -1101,33 +1105,12 @@ mod tests {
         let (mut probed, mut capped) = (ImpactOutcome::default(), ImpactOutcome::default());
         for len in [2, 3] {
             let (bodies, contacts) = star(len, 1.0);
-            let how = solver
-                .solve_into(
-                    &bodies,
-                    &contacts,
-                    &at_rest_fraction(),
-                    &budgeted(),
-                    &mut probed,
-                )
-                .unwrap();
-            let work = solver.last_work();
-            let whole_cap = FallbackPolicy {
-                probe_large_groups: false,
-                ..budgeted()
-            };
-            solver
-                .solve_into(
-                    &bodies,
-                    &contacts,
-                    &at_rest_fraction(),
-                    &whole_cap,
-                    &mut capped,
-                )
-                .unwrap();
+            let ((how, work), (_, cap_alone)) =
+                probe_and_cap_alone(&mut solver, &bodies, &contacts, &mut probed, &mut capped);
             assert_eq!(how, Resolution::Lzb, "{len}");
             assert_eq!(
                 (probed.bodies.clone(), work),
-                (capped.bodies.clone(), solver.last_work())
+                (capped.bodies.clone(), cap_alone)
             );
             // e = 1: energy is lost only where the impact ends at its rest
             // speed v_r, each point dropping what it stores below a rebound
