@@ -170,19 +170,11 @@ pub(super) fn push_with(
     f: f64,
     acc: &mut [f64],
 ) {
-    let [ma, ia, mb, ib] = inverse;
-    let pa = &mut acc[3 * a..3 * a + 3];
-    pa[0] -= ma * f * axis.dir[0];
-    pa[1] -= ma * f * axis.dir[1];
-    pa[2] -= ia * f * axis.arm_a;
-    let pb = &mut acc[3 * b..3 * b + 3];
-    pb[0] += mb * f * axis.dir[0];
-    pb[1] += mb * f * axis.dir[1];
-    pb[2] += ib * f * axis.arm_b;
+    push_slots(inverse, a, b, axis, f, acc.as_chunks_mut::<3>().0);
 }
 
 /// [`push_with`] on the accelerations as [ax, ay, α] per body slot (one
-/// bounds check per body; the same operations).
+/// bounds check per body).
 #[inline]
 pub(super) fn push_slots(
     inverse: [f64; 4],
@@ -204,7 +196,7 @@ pub(super) fn push_slots(
 }
 
 /// [`rate`] on the velocities as [vx, vy, ω] per body slot (one bounds
-/// check per body; the same operations).
+/// check per body).
 #[inline]
 pub(super) fn slot_rate(v: &[[f64; 3]], a: usize, b: usize, axis: &Axis) -> f64 {
     let (va, vb) = (&v[a], &v[b]);
@@ -216,10 +208,7 @@ pub(super) fn slot_rate(v: &[[f64; 3]], a: usize, b: usize, axis: &Axis) -> f64 
 /// (or accelerations) `v`: dir·(v_b − v_a) + ω_b arm_b − ω_a arm_a.
 #[inline]
 pub(super) fn rate(v: &[f64], a: usize, b: usize, axis: &Axis) -> f64 {
-    let va = &v[3 * a..3 * a + 3];
-    let vb = &v[3 * b..3 * b + 3];
-    axis.dir[0] * (vb[0] - va[0]) + axis.dir[1] * (vb[1] - va[1]) + vb[2] * axis.arm_b
-        - va[2] * axis.arm_a
+    slot_rate(v.as_chunks::<3>().0, a, b, axis)
 }
 
 /// Normal rate δ̇ of a row (m/s).
