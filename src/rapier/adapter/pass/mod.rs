@@ -344,9 +344,8 @@ impl ImpactPass {
         let touch = closed_tolerance(settings).max(world.allowed);
         for k in 0..self.candidates.len() {
             if self.gap(world, k, 0.0, touch).is_some() {
-                // touching now: Rapier's, or an impact at once; the frame
-                // is cut only if a body of the pair pivots
-                out.moving_contact = out.moving_contact || self.pivots(world, k, touch);
+                // touching now: Rapier's, or an impact at once
+                out.moving_contact = true;
                 continue;
             }
             let t = self.time_of_impact(world, settings, k);
@@ -356,32 +355,6 @@ impl ImpactPass {
         }
         self.candidates.clear();
         out
-    }
-
-    /// Whether a body of touching candidate `k` pivots over the rest of the
-    /// frame (the prediction's horizon τ, s) far enough that one Rapier step
-    /// misses its contact: Rapier solves a step on the contact manifold of
-    /// the step's start, linearised in the bodies' motion, and a point at
-    /// distance r (m, the body's bounding radius) from the centre of mass of
-    /// a body turning at ω (rad/s) leaves the tangent line of its linearised
-    /// motion by r·(1 − cos ωτ) ≤ r·(ωτ)²/2 (the chord's sagitta). The pair
-    /// counts when that exceeds `tolerance` (m, the gap the prediction
-    /// already treats as touching: below it one step cannot tell the arc
-    /// from its tangent), i.e. when ωτ > θ_min = √(2·tolerance / r). A body
-    /// that slides or settles (small ωτ) leaves the pair to one step.
-    fn pivots(&mut self, world: &World, k: usize, tolerance: f64) -> bool {
-        let tau = self.motion.dt;
-        self.candidates[k].colliders.into_iter().any(|c| {
-            let Some(h) = world.colliders.get(c).and_then(|co| co.parent()) else {
-                return false;
-            };
-            let Some(rb) = world.bodies.get(h).filter(|rb| rb.is_dynamic()) else {
-                return false;
-            };
-            let turn = f64::from(rb.angvel()).abs() * tau;
-            let radius = self.radius(world, h, rb);
-            0.5 * radius * turn * turn > tolerance * pivot_scale()
-        })
     }
 
     /// Writes the new velocities and end poses of every body an impact
@@ -421,14 +394,4 @@ fn closed_tolerance(s: &ToppleSettings) -> f64 {
     s.patch
         .closed_tolerance
         .max(64.0 * f64::from(Real::EPSILON))
-}
-
-fn pivot_scale() -> f64 {
-    static SCALE: std::sync::OnceLock<f64> = std::sync::OnceLock::new();
-    *SCALE.get_or_init(|| {
-        std::env::var("TOPPLE_PIVOT")
-            .ok()
-            .and_then(|v| v.parse().ok())
-            .unwrap_or(1.0)
-    })
 }
