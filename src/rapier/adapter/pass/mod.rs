@@ -344,16 +344,8 @@ impl ImpactPass {
         let touch = closed_tolerance(settings).max(world.allowed);
         for k in 0..self.candidates.len() {
             if self.gap(world, k, 0.0, touch).is_some() {
-                // touching now: Rapier's, or an impact at once; the frame
-                // is cut only if the pair's present motion (the bodies'
-                // linear and angular velocities, the pivot's arc included)
-                // would drive it deeper than the touching tolerance by the
-                // end of the frame
-                let tau = self.motion.dt;
-                out.moving_contact = out.moving_contact
-                    || self
-                        .gap(world, k, tau, 2.0 * touch)
-                        .is_some_and(|g| g < -touch);
+                // touching now: Rapier's, or an impact at once
+                out.moving_contact = true;
                 continue;
             }
             let t = self.time_of_impact(world, settings, k);
