@@ -30,8 +30,9 @@
 //! the native app, topple's whole step with its Rapier pieces in topple's),
 //! which leaves out Bevy's schedule around it. On an idle virtual machine a
 //! frame's wall time holds the wake-ups of Bevy's executor threads, which
-//! cost as much as a small scene's physics (docs/bevy.md, "The frame bench
-//! on an idle machine"); the physics step's ratio does not.
+//! cost more than a small scene's physics (docs/bevy.md, "The merged code
+//! of round thirteen, and what a frame ratio measures"); the physics
+//! step's ratio does not.
 
 #[path = "../examples/common/scenes.rs"]
 mod scenes;
