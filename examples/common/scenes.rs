@@ -216,6 +216,38 @@ pub fn block(
     e.id()
 }
 
+/// A domino of height `h` and thickness `d` (px) standing with its bottom
+/// centre at `foot`; with `push = Some(k)` it turns about its front bottom
+/// edge at θ̇ = k √(g/h) (the paper's push of k), clockwise, towards +x.
+pub fn standing_domino(
+    commands: &mut Commands,
+    target: Target,
+    h: f32,
+    d: f32,
+    foot: Vec2,
+    push: Option<f32>,
+) -> Entity {
+    let e = block(
+        commands,
+        target,
+        Vec2::new(d, h),
+        foot + Vec2::new(0.0, 0.5 * h),
+        0.0,
+        Role::Domino,
+        Mat::DOMINO,
+    );
+    if let Some(k) = push {
+        // clockwise about the front bottom edge: v = ω × (centre − pivot)
+        let w = -k * (G / h).sqrt();
+        let r = Vec2::new(-0.5 * d, 0.5 * h);
+        commands.entity(e).insert(Velocity {
+            linear: Vec2::new(-w * r.y, w * r.x),
+            angular: w,
+        });
+    }
+    e
+}
+
 /// A box pyramid standing at rest on the ground: `levels` rows of boxes of
 /// `size` px, the bottom row centred at x = 0 on a ground at y = 0.
 pub fn pyramid(commands: &mut Commands, target: Target, levels: usize, size: f32) -> Vec<Entity> {

@@ -15,7 +15,7 @@
 use bevy::prelude::*;
 use bevy_rapier2d::prelude::*;
 
-use super::scenes::{self, Mat, Piece, PieceShape, Role, Target, G};
+use super::scenes::{self, Mat, Piece, PieceShape, Role, Target};
 
 /// Height and thickness of a front's dominoes (px) and their spacing over
 /// height.
@@ -66,24 +66,8 @@ fn domino(
     foot: Vec2,
     pushed: bool,
 ) -> Entity {
-    let e = scenes::block(
-        commands,
-        target,
-        Vec2::new(d, h),
-        foot + Vec2::new(0.0, 0.5 * h),
-        0.0,
-        Role::Domino,
-        Mat::DOMINO,
-    );
-    if pushed {
-        // clockwise about the front bottom edge: v = ω × (centre − pivot)
-        let w = -(G / h).sqrt();
-        let r = Vec2::new(-0.5 * d, 0.5 * h);
-        commands.entity(e).insert(Velocity {
-            linear: Vec2::new(-w * r.y, w * r.x),
-            angular: w,
-        });
-    } else {
+    let e = scenes::standing_domino(commands, target, h, d, foot, pushed.then_some(1.0));
+    if !pushed {
         commands.entity(e).insert(Sleeping {
             sleeping: true,
             ..Sleeping::default()

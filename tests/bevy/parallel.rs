@@ -9,7 +9,7 @@ use crate::example_scenes as scenes;
 
 use bevy::prelude::*;
 use bevy_rapier2d::prelude::*;
-use scenes::{Mat, Role, Target, G};
+use scenes::{Mat, Target};
 use topple::bevy::{ImpactResponse, ToppleFrameStats, ToppleImpact, ToppleWorld};
 
 /// `fronts` rows of 12 dominoes (32 × 7 px at s/h 0.5) on their own
@@ -37,25 +37,8 @@ fn spawn_fronts(commands: &mut Commands, fronts: usize) -> Vec<Entity> {
         );
         for i in 0..12 {
             let foot = Vec2::new(x0 + 0.5 * d + pitch * i as f32, y);
-            let e = scenes::block(
-                commands,
-                target,
-                Vec2::new(d, h),
-                foot + Vec2::new(0.0, 0.5 * h),
-                0.0,
-                Role::Domino,
-                Mat::DOMINO,
-            );
-            if i == 0 {
-                // clockwise about the front bottom edge: v = ω × (centre − pivot)
-                let w = -(1.0 + 0.1 * k as f32) * (G / h).sqrt();
-                let r = Vec2::new(-0.5 * d, 0.5 * h);
-                commands.entity(e).insert(Velocity {
-                    linear: Vec2::new(-w * r.y, w * r.x),
-                    angular: w,
-                });
-            }
-            all.push(e);
+            let push = (i == 0).then_some(1.0 + 0.1 * k as f32);
+            all.push(scenes::standing_domino(commands, target, h, d, foot, push));
         }
     }
     all
